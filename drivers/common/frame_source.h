@@ -1,0 +1,33 @@
+#pragma once
+// FrameSource: the one interface every producer of RGB-D frames implements — dataset replay,
+// synthetic scenes, our recordings, OpenNI2, V4L2. The pipeline's capture stage only sees this.
+#include <string>
+
+#include "pipeline/camera.h"
+#include "pipeline/rgbd_image.h"
+#include "platform/status.h"
+
+namespace plumb {
+
+enum class SourceResult {
+  kFrame,        // `out` holds a new frame
+  kEndOfStream,  // a finite source is exhausted (clean end)
+  kNoFrame,      // a live source had nothing this time (timeout); try again
+  kError,        // see lastError(); a live source may recover after reopen()
+};
+
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+  // Fills `out` (reusing its buffers). Never throws.
+  virtual SourceResult next(RgbdImage& out) = 0;
+  virtual const PinholeCamera& camera() const = 0;
+  // Human-readable name, e.g. "tum:/data/fr1_rpy" or "openni2:first".
+  virtual std::string describe() const = 0;
+  virtual const Status& lastError() const = 0;
+  // For live sources: try to reopen after an error (returns the outcome). Replays: no-op error.
+  virtual Status reopen() { return Status::Error(describe() + ": cannot be reopened"); }
+  virtual bool isLive() const { return false; }
+};
+
+}  // namespace plumb

@@ -1,0 +1,1 @@
+// Placeholder so the common library has a source until its first real one lands; delete then.

@@ -1,0 +1,84 @@
+#pragma once
+// PinholeCamera: intrinsics, Brown-Conrady distortion (k1 k2 p1 p2 k3, OpenCV order), image size,
+// depth scale and the virtual stereo baseline used by the RGB-D point observation [u, v, u_r]
+// (u_r = u - fx * b / d, paper section V-D).
+//
+// fy may be negative (ICL-NUIM's TUM-format ground truth needs fy = -480): nothing here assumes
+// fx, fy > 0, only that they are finite and non-zero.
+//
+// Features are detected on the raw (distorted) image; their coordinates are undistorted once
+// (undistortPoint) and everything downstream (matching by projection, the solver) works in the
+// ideal pinhole model.
+#include <cmath>
+#include <string>
+
+#include <Eigen/Core>
+
+namespace plumb {
+
+struct PinholeCamera {
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  double k1 = 0, k2 = 0, p1 = 0, p2 = 0, k3 = 0;
+  int width = 640, height = 480;
+  // Raw depth units per metre (TUM: 5000, Kinect mm images: 1000).
+  double depth_factor = 5000.0;
+  // Virtual baseline in metres for u_r = u - fx*b/d (ORB-SLAM2's RGB-D convention: 0.08 m).
+  double baseline_m = 0.08;
+
+  bool hasDistortion() const { return k1 != 0 || k2 != 0 || p1 != 0 || p2 != 0 || k3 != 0; }
+
+  // Ideal pinhole projection of a point in the camera frame (z > 0 expected).
+  Eigen::Vector2d project(const Eigen::Vector3d& P_cam) const {
+    return {fx * P_cam.x() / P_cam.z() + cx, fy * P_cam.y() / P_cam.z() + cy};
+  }
+  // Back-projection of an undistorted pixel at depth d (metres, along the optical axis).
+  Eigen::Vector3d unproject(double u, double v, double depth_m) const {
+    return {(u - cx) / fx * depth_m, (v - cy) / fy * depth_m, depth_m};
+  }
+
+  // Distorted pixel -> undistorted (ideal) pixel, by fixed-point iteration on the normalised
+  // coordinates (converges in a handful of steps for the distortion of Kinect-class lenses).
+  Eigen::Vector2d undistortPoint(double u, double v) const {
+    if (!hasDistortion()) return {u, v};
+    const double xd = (u - cx) / fx, yd = (v - cy) / fy;
+    double x = xd, y = yd;
+    for (int it = 0; it < 10; ++it) {
+      const double r2 = x * x + y * y;
+      const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
+      const double dx = 2 * p1 * x * y + p2 * (r2 + 2 * x * x);
+      const double dy = p1 * (r2 + 2 * y * y) + 2 * p2 * x * y;
+      x = (xd - dx) / radial;
+      y = (yd - dy) / radial;
+    }
+    return {fx * x + cx, fy * y + cy};
+  }
+  // Ideal pixel -> distorted pixel (the forward lens model).
+  Eigen::Vector2d distortPoint(double u, double v) const {
+    if (!hasDistortion()) return {u, v};
+    const double x = (u - cx) / fx, y = (v - cy) / fy;
+    const double r2 = x * x + y * y;
+    const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
+    const double xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x);
+    const double yd = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y;
+    return {fx * xd + cx, fy * yd + cy};
+  }
+
+  bool inImage(double u, double v, double border = 0) const {
+    return u >= border && v >= border && u < width - border && v < height - border;
+  }
+
+  // Empty string when valid; otherwise what is wrong (NaN, zero focal length, bad size...).
+  std::string validate() const {
+    auto finite = [](double x) { return std::isfinite(x); };
+    if (!finite(fx) || !finite(fy) || !finite(cx) || !finite(cy)) return "intrinsics are not finite";
+    if (!finite(k1) || !finite(k2) || !finite(p1) || !finite(p2) || !finite(k3))
+      return "distortion coefficients are not finite";
+    if (fx == 0 || fy == 0) return "focal length is zero";
+    if (width <= 0 || height <= 0) return "image size must be positive";
+    if (!finite(depth_factor) || depth_factor <= 0) return "depth factor must be positive";
+    if (!finite(baseline_m) || baseline_m <= 0) return "baseline must be positive";
+    return "";
+  }
+};
+
+}  // namespace plumb

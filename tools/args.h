@@ -1,0 +1,69 @@
+#pragma once
+// Tiny argument reader shared by the subcommands: `--key value`, `--flag`, and positionals.
+// Unknown options are an error, so a typo never silently falls back to a default.
+#include <cstdlib>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace plumb::tools {
+
+class Args {
+ public:
+  // value_options take a value (`--out DIR`); flag_options do not (`--json`).
+  Args(int argc, char** argv, std::set<std::string> value_options, std::set<std::string> flag_options) {
+    for (int i = 0; i < argc; ++i) {
+      std::string a = argv[i];
+      if (a == "--help" || a == "-h") { help_ = true; continue; }
+      if (a.rfind("--", 0) == 0) {
+        std::string key = a.substr(2);
+        if (value_options.count(key)) {
+          if (i + 1 >= argc) { error_ = "option --" + key + " needs a value"; return; }
+          values_[key] = argv[++i];
+        } else if (flag_options.count(key)) {
+          flags_.insert(key);
+        } else {
+          error_ = "unknown option " + a;
+          return;
+        }
+      } else {
+        positional_.push_back(a);
+      }
+    }
+  }
+  bool help() const { return help_; }
+  const std::string& error() const { return error_; }
+  bool has(const std::string& key) const { return values_.count(key) || flags_.count(key); }
+  std::string get(const std::string& key, const std::string& fallback = "") const {
+    auto it = values_.find(key);
+    return it == values_.end() ? fallback : it->second;
+  }
+  // Parses an integer option; sets *ok=false (and leaves fallback) when malformed.
+  long getInt(const std::string& key, long fallback, bool* ok) const {
+    auto it = values_.find(key);
+    if (it == values_.end()) return fallback;
+    char* end = nullptr;
+    long v = std::strtol(it->second.c_str(), &end, 10);
+    if (end == it->second.c_str() || *end != '\0') { *ok = false; return fallback; }
+    return v;
+  }
+  double getDouble(const std::string& key, double fallback, bool* ok) const {
+    auto it = values_.find(key);
+    if (it == values_.end()) return fallback;
+    char* end = nullptr;
+    double v = std::strtod(it->second.c_str(), &end);
+    if (end == it->second.c_str() || *end != '\0') { *ok = false; return fallback; }
+    return v;
+  }
+  const std::vector<std::string>& positional() const { return positional_; }
+
+ private:
+  bool help_ = false;
+  std::string error_;
+  std::map<std::string, std::string> values_;
+  std::set<std::string> flags_;
+  std::vector<std::string> positional_;
+};
+
+}  // namespace plumb::tools
