@@ -1,0 +1,22 @@
+#pragma once
+// Camera file: one `key value` per line, `#` starts a comment. Keys:
+//   fx fy cx cy            intrinsics in pixels (required; fy may be negative, never zero)
+//   k1 k2 p1 p2 k3         Brown-Conrady distortion, OpenCV order (optional, default 0)
+//   width height           image size in pixels (optional, default 640 480)
+//   depth_factor           raw depth units per metre (optional, default 5000)
+//   baseline               virtual stereo baseline in metres (optional, default 0.08)
+// Unknown keys, repeated keys, unparsable or non-finite values are errors naming file and line.
+// Format documented in docs/DATA_FORMATS.md.
+#include <string>
+
+#include "pipeline/camera.h"
+#include "platform/status.h"
+
+namespace plumb {
+
+Status readCameraFile(const std::string& path, PinholeCamera* out);
+
+// Writes every key with full precision (%.17g), so read(write(c)) == c bit for bit.
+Status writeCameraFile(const std::string& path, const PinholeCamera& camera);
+
+}  // namespace plumb

@@ -1,0 +1,67 @@
+#pragma once
+// TumDatasetSource: replays a folder in the TUM RGB-D layout (also ICL-NUIM in TUM format):
+//   rgb/*.png  depth/*.png  rgb.txt  depth.txt  [associations.txt]  [groundtruth.txt]
+// Frames are the lines of associations.txt (`t_rgb rgb/X.png t_depth depth/Y.png`); without it,
+// rgb.txt and depth.txt are paired with the benchmark's rule (greedy unique pairs by smallest
+// |dt|, |dt| < 0.02 s), see drivers/common/timestamp_association.h.
+//
+// Every list problem (missing/empty/unparsable list, non-monotonic or duplicate timestamps) is
+// reported by open(); image problems (missing, corrupt or truncated PNG, wrong size or bit depth)
+// by next()/load(). Messages name the file and, for lists, the line.
+//
+// Buffers: PNGs are read into a reused byte buffer and decoded with cv::imdecode straight into the
+// caller's RgbdImage Mats. libpng decoding still allocates internally, so replay is not
+// allocation-free; live sources are the ones held to that contract.
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "drivers/common/frame_source.h"
+
+namespace plumb {
+
+// One associated RGB-D pair; paths are relative to the dataset folder.
+struct TumFrameEntry {
+  double rgb_timestamp_s = 0;
+  std::string rgb_path;
+  double depth_timestamp_s = 0;
+  std::string depth_path;
+};
+
+class TumDatasetSource : public FrameSource {
+ public:
+  // Reads the lists of `dir` and checks them; `camera` must already be valid and its size is the
+  // size every image must have.
+  static Status open(const std::string& dir, const PinholeCamera& camera,
+                     std::unique_ptr<TumDatasetSource>* out);
+
+  // Sequential replay: frame 0, 1, ... then kEndOfStream. kError leaves lastError() set.
+  SourceResult next(RgbdImage& out) override;
+  const PinholeCamera& camera() const override { return camera_; }
+  std::string describe() const override { return "tum:" + dir_; }
+  const Status& lastError() const override { return last_error_; }
+
+  // Random access (does not move the replay cursor). Fills out.sequence = i.
+  Status load(std::size_t i, RgbdImage& out);
+  std::size_t size() const { return frames_.size(); }
+  double timestamp(std::size_t i) const { return frames_[i].rgb_timestamp_s; }
+  const TumFrameEntry& entry(std::size_t i) const { return frames_[i]; }
+  // True when the pairs were read from associations.txt (false: associated here).
+  bool usedAssociationsFile() const { return used_associations_file_; }
+  void rewind() { cursor_ = 0; }
+
+ private:
+  TumDatasetSource() = default;
+  Status loadImage(const std::string& relative_path, bool is_depth, cv::Mat& dst);
+
+  std::string dir_;
+  PinholeCamera camera_;
+  std::vector<TumFrameEntry> frames_;
+  bool used_associations_file_ = false;
+  std::size_t cursor_ = 0;
+  Status last_error_;
+  std::vector<unsigned char> file_bytes_;  // reused read buffer for PNG files
+};
+
+}  // namespace plumb

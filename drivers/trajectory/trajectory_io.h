@@ -1,0 +1,70 @@
+#pragma once
+// TUM trajectory files: `timestamp tx ty tz qx qy qz qw` per line, the pose T_world_cam (camera
+// optical centre and orientation in the world frame, qw last). `#` lines are comments; commas and
+// tabs are accepted as separators, like the benchmark's scripts.
+//
+// plumb writes one line per input frame. A frame without a pose (tracking lost, not initialised)
+// is written as the comment line `# <timestamp> lost`, so the benchmark tools still parse the file
+// and simply see no pose at that time. See docs/DATA_FORMATS.md.
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "platform/status.h"
+
+namespace plumb {
+
+struct StampedPose {
+  double timestamp = 0;
+  Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
+  bool valid = true;  // false: the frame had no pose (written as `# <timestamp> lost`)
+};
+
+struct TrajectoryReadOptions {
+  // A quaternion whose norm is within this of 1 is normalised (files print 4-9 digits); further
+  // away, or zero, is an error.
+  double quaternion_norm_tolerance = 0.05;
+  // Return `# <timestamp> lost` markers as StampedPose{valid=false}; otherwise skip them.
+  bool keep_lost_markers = false;
+};
+
+struct TrajectoryReadReport {
+  // Lines whose timestamp equals the previous one. The benchmark reads files into a dictionary,
+  // so the later line wins; we do the same and count them (fr2/desk's ground truth has one).
+  int duplicate_timestamps_replaced = 0;
+  int quaternions_normalised = 0;  // norms off by more than 1e-6 that were normalised
+};
+
+// Errors name file and line: wrong column count, unparsable or non-finite numbers, zero or
+// far-from-unit quaternions, decreasing timestamps, no poses at all.
+Status readTumTrajectory(const std::string& path, std::vector<StampedPose>* out,
+                         const TrajectoryReadOptions& options = {},
+                         TrajectoryReadReport* report = nullptr);
+
+// One line for a pose: `%.6f` timestamp, `%.9g` numbers, or `# %.6f lost` when !valid.
+// Deterministic bytes (C locale number formatting, no trailing spaces), no newline.
+std::string formatTumLine(const StampedPose& pose);
+
+// Writes the header comment and one line per pose.
+Status writeTumTrajectory(const std::string& path, const std::vector<StampedPose>& poses);
+
+// Streaming writer for a running system: append() per frame, flushed on close()/destruction.
+class TumTrajectoryWriter {
+ public:
+  TumTrajectoryWriter() = default;
+  ~TumTrajectoryWriter();
+  TumTrajectoryWriter(const TumTrajectoryWriter&) = delete;
+  TumTrajectoryWriter& operator=(const TumTrajectoryWriter&) = delete;
+
+  Status open(const std::string& path);
+  Status append(const StampedPose& pose);
+  Status close();
+
+ private:
+  std::string path_;
+  std::FILE* file_ = nullptr;
+};
+
+}  // namespace plumb
