@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include "pipeline/capacities.h"
+#include "pipeline/matcher_grid.h"
 #include "platform/fixed_vector.h"
 
 namespace plumb {
@@ -67,12 +68,15 @@ struct FrameFeatures {
   FixedVector<Descriptor256, kMaxKeypoints> keypoint_descriptors;  // parallel to keypoints
   FixedVector<LineObservation, kMaxLines> lines;
   FixedVector<Descriptor256, kMaxLines> line_descriptors;  // LBD, parallel to lines
+  // Bucket grid over keypoints[i].px_undist, built by the extractor (matching by projection).
+  KeypointGrid keypoint_grid;
 
   void clear() {
     keypoints.clear();
     keypoint_descriptors.clear();
     lines.clear();
     line_descriptors.clear();
+    keypoint_grid.built = false;
   }
 };
 
