@@ -1,0 +1,216 @@
+#pragma once
+// Bounded-window local bundle adjustment with a hand-written dense Schur complement.
+//
+// VARIABLES. K optimised keyframe poses T_cam_world (6-dof left perturbation, solver/se3.h) and
+// L landmarks P_world (3-dof; map points and line-guidance points alike). Fixed keyframes
+// contribute residuals but no variables: they hold the gauge. Without any fixed keyframe the
+// problem has a 6-dof gauge freedom; LM damping still gives steps, but covariance() then fails.
+//
+// COST. 0.5 * sum_obs rho(e^T Omega e) with the factors of solver/factors.h (stereo [u,v,u_r],
+// mono [u,v], line sample l^T pi(T P)) and the kernels of solver/robust_kernel.h. Each iteration
+// linearises with IRLS weights w = rho'(s), giving the normal equations H dx = -g:
+//
+//          6K          3L
+//       +--------+-----------------+        H_pp: block diagonal (one 6x6 per keyframe: every
+//   6K  |  H_pp  |      H_pl       |              observation touches exactly one pose)
+//       +--------+-----------------+        H_pl: one 6x3 block W_ij per observation (i, j)
+//   3L  |  H_lp  |  H_ll (3x3 diag)|        H_ll: block diagonal, one 3x3 per landmark
+//       +--------+-----------------+
+//
+// SCHUR COMPLEMENT. Eliminating the landmarks (cheap: H_ll is block diagonal) leaves the reduced
+// camera system of size 6K:
+//
+//   S  = H_pp - H_pl H_ll^-1 H_lp,        S_ik = [i==k] H_ii - sum_j W_ij H_jj^-1 W_kj^T
+//   S dx_p = -(g_p - H_pl H_ll^-1 g_l)
+//   dx_l_j = -H_jj^-1 (g_l_j + sum_i W_ij^T dx_p_i)        (back-substitution per landmark)
+//
+// S is dense 6K x 6K (every pair of keyframes sharing a landmark couples) and small (60 x 60 for
+// K = 10), so it is factorised by a dense in-place Cholesky (solver/dense_cholesky.h).
+//
+// LEVENBERG-MARQUARDT. The damped system adds lambda * clamp(diag(H), 1e-6, 1e32) to the diagonal
+// of BOTH H_pp and H_ll before elimination (Ceres' schedule: lambda = 1 / trust radius, radius
+// grown by 1 / max(1/3, 1 - (2 rho - 1)^3) on success and shrunk by a doubling factor on failure).
+// A rejected step re-eliminates from the stored linearisation without re-evaluating residuals.
+//
+// DEGENERATE LANDMARKS. A landmark whose (damped) 3x3 block is not safely positive definite (one
+// line observation, all observations behind the camera, a point at a camera centre) is held fixed
+// for that linearisation: its observations still constrain the poses like pose-only factors,
+// it gets no step, and it never produces Inf or NaN. Observations with the point behind the camera
+// (Z <= 0) are dropped from the linearisation and flagged outliers.
+//
+// COVARIANCE (paper eq. 12). At the current estimate, undamped, with the same IRLS weights:
+//   C = (H_A - H_B H_C^-1 H_B^T)^-1 = S^-1,   H_A = H_pp, H_B = H_pl, H_C = H_ll,
+// the joint covariance of the K optimised poses (landmarks marginalised). covariance(kf) is the
+// 6x6 diagonal block; fullCovariance() the whole 6K x 6K matrix, rows/cols ordered by
+// poseVariableIndex(). Landmarks with a singular H_C block are left out (treated as fixed).
+//
+// MEMORY. reserve() allocates every buffer once for the given maxima; add*(), solve(),
+// computeCovariance() and computeStep() never touch the heap (proved by a test hooking operator
+// new). Buffers: per keyframe (pose, 6x6 H_pp block, g_p, pose step), per landmark (point,
+// 3x3 H_ll, its Cholesky inverse, g_l, step, first-observation offset), per observation (kind,
+// z, Omega, W_ij = J_pose^T w Omega J_point, V_ij = W_ij H_jj^-1, chi2), one dense S and one
+// dense covariance of the maximal 6K x 6K size, used through their top-left corners.
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "solver/camera_intrinsics.h"
+#include "solver/robust_kernel.h"
+#include "solver/types.h"
+
+namespace plumb {
+
+struct LocalBaOptions {
+  int max_iterations = 10;  // LM iterations (accepted and rejected steps both count)
+  RobustKernelType kernel = RobustKernelType::kPseudoHuber;
+  // Kernel widths per residual dimension (whitened units; sqrt of 95% chi-square quantiles).
+  double kernel_delta_stereo = 2.7955;  // sqrt(7.815)
+  double kernel_delta_mono = 2.4477;    // sqrt(5.991)
+  double kernel_delta_line = 1.9598;    // sqrt(3.841)
+  // Chi-square thresholds for the outlier flags written after solve() (for map culling).
+  double chi2_stereo = 7.815;
+  double chi2_mono = 5.991;
+  double chi2_line = 3.841;
+  double initial_trust_radius = 1e4;  // lambda = 1 / radius
+  double max_trust_radius = 1e16;
+  double min_relative_decrease = 1e-3;  // accept a step when actual / predicted exceeds this
+  // Stop when |cost change| / cost of an accepted step falls below this (0: run all iterations).
+  double function_tolerance = 1e-6;
+  // Relative pivot below which a 3x3 landmark block counts as singular (landmark held fixed).
+  double landmark_singular_threshold = 1e-12;
+};
+
+enum class LocalBaStatus {
+  kConverged,            // function_tolerance reached
+  kMaxIterations,        // ran max_iterations (the usual outcome in a real-time window)
+  kNoVariables,          // nothing to optimise (no free keyframe and no landmark)
+  kLinearSolverFailed,   // S not positive definite even with damping (covariance: gauge free)
+};
+
+struct LocalBaSummary {
+  LocalBaStatus status = LocalBaStatus::kNoVariables;
+  int iterations = 0;
+  int successful_steps = 0;
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  int num_outliers = 0;          // observations above their chi-square threshold at the end
+  int num_fixed_landmarks = 0;   // landmarks held fixed as degenerate in the last linearisation
+  bool ok() const { return status == LocalBaStatus::kConverged || status == LocalBaStatus::kMaxIterations; }
+};
+
+const char* toString(LocalBaStatus status);
+
+enum class ObservationKind : uint8_t { kStereoPoint, kMonoPoint, kLineSample };
+
+class LocalBundleAdjuster {
+ public:
+  static constexpr int kDefaultMaxKeyframes = 10;  // optimised keyframes (plus fixed ones)
+
+  // Allocates all buffers. max_keyframes counts fixed and optimised keyframes together.
+  void reserve(int max_keyframes, int max_landmarks, int max_observations);
+  void setCamera(const CameraIntrinsics& camera) { camera_ = camera; }
+  // Forget keyframes, landmarks and observations; keeps the reserved memory.
+  void clear();
+
+  // Each add returns the new index, or -1 when the reserved capacity is full or an index is
+  // out of range (nothing is added then).
+  int addKeyframe(const Eigen::Isometry3d& T_cam_world, bool fixed);
+  int addLandmark(const Eigen::Vector3d& P_world);
+  int addStereoPointObservation(int keyframe, int landmark, const Eigen::Vector3d& z_uvr,
+                                const Eigen::Matrix3d& information);
+  int addMonoPointObservation(int keyframe, int landmark, const Eigen::Vector2d& z_uv,
+                              const Eigen::Matrix2d& information);
+  // `line` normalised ([a, b, c], a^2 + b^2 = 1, see normalizeLine()).
+  int addLineObservation(int keyframe, int landmark, const Eigen::Vector3d& line, double information);
+  // Disabled observations are ignored by solve() and covariance (e.g. after outlier culling).
+  void setObservationEnabled(int observation, bool enabled);
+
+  // Levenberg-Marquardt from the current estimate; updates poses and landmarks in place and the
+  // per-observation chi2 / outlier flags at the end.
+  LocalBaSummary solve(const LocalBaOptions& options);
+
+  // Linearise at the current estimate (undamped) and compute C = S^-1. Returns false when S is
+  // not positive definite (e.g. no fixed keyframe, or a keyframe without constraints).
+  bool computeCovariance(const LocalBaOptions& options);
+  Matrix6d covariance(int keyframe) const;  // zero for fixed keyframes
+  Eigen::Block<const Eigen::MatrixXd> fullCovariance() const;
+  int numPoseVariables() const { return num_pose_variables_; }
+  int poseVariableIndex(int keyframe) const { return keyframes_[keyframe].variable; }  // -1: fixed
+
+  int numKeyframes() const { return num_keyframes_; }
+  int numLandmarks() const { return num_landmarks_; }
+  int numObservations() const { return num_observations_; }
+  const Eigen::Isometry3d& pose(int keyframe) const { return keyframes_[keyframe].T_cam_world; }
+  const Eigen::Vector3d& landmark(int landmark) const { return landmarks_[landmark].P_world; }
+  double observationChi2(int observation) const { return observations_[observation].chi2; }
+  bool isOutlier(int observation) const { return observations_[observation].outlier; }
+  double cost(const LocalBaOptions& options) const;  // robust cost at the current estimate
+
+  // Diagnostics (tests): linearise at the current estimate and solve ONE damped step with the
+  // given lambda, without applying it. Returns false if the damped S is not positive definite.
+  bool computeStep(const LocalBaOptions& options, double lambda);
+  Vector6d poseStep(int keyframe) const;
+  Eigen::Vector3d landmarkStep(int landmark) const;
+
+ private:
+  struct Keyframe {
+    Eigen::Isometry3d T_cam_world = Eigen::Isometry3d::Identity();
+    Eigen::Isometry3d T_candidate = Eigen::Isometry3d::Identity();
+    Matrix6d H_pose = Matrix6d::Zero();  // undamped diagonal block of H_pp
+    Vector6d g_pose = Vector6d::Zero();
+    Vector6d step = Vector6d::Zero();
+    int variable = -1;  // index into the reduced system; -1 when fixed
+  };
+  struct Landmark {
+    Eigen::Vector3d P_world = Eigen::Vector3d::Zero();
+    Eigen::Vector3d P_candidate = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d H_point = Eigen::Matrix3d::Zero();      // undamped H_ll block
+    Eigen::Matrix3d H_point_inv = Eigen::Matrix3d::Zero();  // damped inverse of the last elimination
+    Eigen::Vector3d g_point = Eigen::Vector3d::Zero();
+    Eigen::Vector3d step = Eigen::Vector3d::Zero();
+    int first_observation = 0;  // into observation_order_ (landmark-major order)
+    int num_observations = 0;
+    bool eliminated = false;  // false: held fixed in the current linearisation
+  };
+  struct Observation {
+    Eigen::Vector3d z = Eigen::Vector3d::Zero();  // [u,v,u_r] | [u,v,-] | line [a,b,c]
+    Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
+    Matrix63d W = Matrix63d::Zero();  // J_pose^T w Omega J_point
+    Matrix63d V = Matrix63d::Zero();  // W H_point_inv
+    double chi2 = 0.0;
+    int keyframe = 0;
+    int landmark = 0;
+    ObservationKind kind = ObservationKind::kStereoPoint;
+    bool enabled = true;
+    bool valid = false;  // point in front of the camera at the last linearisation
+    bool outlier = false;
+  };
+
+  int addObservation(int keyframe, int landmark, ObservationKind kind, const Eigen::Vector3d& z,
+                     const Eigen::Matrix3d& information);
+  void buildStructure();
+  void linearize(const LocalBaOptions& options);
+  bool solveDamped(const LocalBaOptions& options, double lambda);
+  double evaluateCost(const LocalBaOptions& options, bool candidate, bool* all_valid) const;
+  double modelCostReduction(double lambda) const;
+  void updateOutlierFlags(const LocalBaOptions& options, LocalBaSummary* summary);
+
+  CameraIntrinsics camera_;
+  std::vector<Keyframe> keyframes_;
+  std::vector<Landmark> landmarks_;
+  std::vector<Observation> observations_;
+  std::vector<int> observation_order_;  // observation indices grouped by landmark
+  std::vector<int> variable_keyframe_;  // pose variable -> keyframe
+  Eigen::MatrixXd S_;                   // reduced camera system / its Cholesky factor
+  Eigen::VectorXd rhs_;                 // right-hand side / pose step of the reduced system
+  Eigen::MatrixXd covariance_;          // S^-1 (undamped) after computeCovariance()
+  int num_keyframes_ = 0;
+  int num_landmarks_ = 0;
+  int num_observations_ = 0;
+  int num_pose_variables_ = 0;
+  int num_fixed_landmarks_ = 0;
+  bool covariance_valid_ = false;
+};
+
+}  // namespace plumb
