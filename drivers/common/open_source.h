@@ -2,8 +2,10 @@
 // openFrameSource: turns a command-line source specification into a FrameSource.
 //   DIR                          TUM RGB-D / ICL-NUIM (TUM format) folder
 //   synth:PRESET[:SEED[:FRAMES]] synthetic scene rendered on the fly (drivers/synth)
-// camera_spec is a preset (tum1 tum2 tum3 icl) or a camera file; when empty, a folder's own
-// camera.txt is used if present, else tum1 for TUM folders; synthetic scenes bring their camera.
+// camera_spec is a preset (tum1 tum2 tum3 icl) or a camera file. When empty: the folder's own
+// camera.txt if present, else the preset its name implies (freiburg1/fr1 -> tum1, fr2 -> tum2,
+// fr3 -> tum3, icl/living_room/office_room/frei_png -> icl), else an error asking for a camera.
+// Synthetic scenes bring their own exact camera (a camera_spec is then an error).
 #include <memory>
 #include <string>
 

@@ -14,6 +14,9 @@
 
 namespace plumb {
 
+// True for tum1, tum2, tum3, icl.
+bool isCameraPresetName(const std::string& name);
+
 // Fills *out with a named preset (tum1, tum2, tum3, icl). Error lists the known names.
 Status cameraPreset(const std::string& name, PinholeCamera* out);
 

@@ -36,7 +36,8 @@ class TumDatasetSource : public FrameSource {
   static Status open(const std::string& dir, const PinholeCamera& camera,
                      std::unique_ptr<TumDatasetSource>* out);
 
-  // Sequential replay: frame 0, 1, ... then kEndOfStream. kError leaves lastError() set.
+  // Sequential replay: frame 0, 1, ... then kEndOfStream. kError sets lastError(); the cursor
+  // still advances, so the next call tries the following frame.
   SourceResult next(RgbdImage& out) override;
   const PinholeCamera& camera() const override { return camera_; }
   std::string describe() const override { return "tum:" + dir_; }

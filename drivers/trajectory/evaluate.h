@@ -8,7 +8,7 @@
 // RPE (evaluate_rpe.py with --fixed_delta --delta 1 --delta_unit s): for each estimate frame i,
 // j = the estimate frame whose stamp is closest to t_i + delta (pairs where j is the last frame are
 // skipped, as the benchmark does); both ends are matched to the closest ground-truth stamp, which
-// must lie within 2x the median ground-truth interval. Error E = (G_i^-1 G_j)^-1 (E_i^-1 E_j);
+// must lie within 2x the median ground-truth interval. Error E = (E_i^-1 E_j) (G_i^-1 G_j)^-1;
 // translation |t(E)| and rotation angle(E) over that ~1 s interval, reported per second (m/s and
 // deg/s), not divided by the exact interval (the benchmark's convention).
 #include <cstddef>

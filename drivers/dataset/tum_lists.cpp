@@ -1,0 +1,104 @@
+#include "drivers/dataset/tum_lists.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "drivers/common/text_lines.h"
+#include "drivers/common/timestamp_association.h"
+
+namespace plumb {
+namespace {
+
+std::string formatStamp(double t) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.6f", t);
+  return text;
+}
+
+Status parseStamp(const std::string& where, const std::string& token, double* t) {
+  if (!parseDouble(token, t)) return Status::Error(where + ": '" + token + "' is not a timestamp");
+  if (!std::isfinite(*t) || *t < 0)
+    return Status::Error(where + ": timestamp '" + token + "' is not a finite non-negative number");
+  return Status::Ok();
+}
+
+// Timestamps must strictly increase: a duplicate would make two frames indistinguishable, a
+// decrease means a shuffled or concatenated list.
+Status checkIncreasing(const std::string& where, const char* what, double previous, int previous_line,
+                       double current) {
+  if (current > previous) return Status::Ok();
+  const std::string kind = current == previous ? "duplicate " : "non-monotonic ";
+  return Status::Error(where + ": " + kind + what + " timestamp " + formatStamp(current) +
+                       " (previous " + formatStamp(previous) + " on line " +
+                       std::to_string(previous_line) + ")");
+}
+
+}  // namespace
+
+Status readTumImageList(const std::string& list_path, std::vector<TumListEntry>* out) {
+  out->clear();
+  std::vector<TextLine> lines;
+  PLUMB_RETURN_IF_ERROR(readTextLines(list_path, &lines));
+  for (const TextLine& line : lines) {
+    if (line.is_comment) continue;
+    const std::string where = fileLine(list_path, line.number);
+    if (line.tokens.size() != 2)
+      return Status::Error(where + ": expected `timestamp filename`, got " +
+                           std::to_string(line.tokens.size()) + " fields");
+    TumListEntry entry;
+    PLUMB_RETURN_IF_ERROR(parseStamp(where, line.tokens[0], &entry.timestamp_s));
+    entry.path = line.tokens[1];
+    entry.line = line.number;
+    if (!out->empty())
+      PLUMB_RETURN_IF_ERROR(checkIncreasing(where, "image", out->back().timestamp_s,
+                                            out->back().line, entry.timestamp_s));
+    out->push_back(std::move(entry));
+  }
+  if (out->empty()) return Status::Error(list_path + ": empty list (no image lines)");
+  return Status::Ok();
+}
+
+Status readTumAssociations(const std::string& list_path, std::vector<TumFrameEntry>* out) {
+  out->clear();
+  std::vector<TextLine> lines;
+  PLUMB_RETURN_IF_ERROR(readTextLines(list_path, &lines));
+  int previous_line = 0;
+  for (const TextLine& line : lines) {
+    if (line.is_comment) continue;
+    const std::string where = fileLine(list_path, line.number);
+    if (line.tokens.size() != 4)
+      return Status::Error(where + ": expected `t_rgb rgb_file t_depth depth_file`, got " +
+                           std::to_string(line.tokens.size()) + " fields");
+    TumFrameEntry entry;
+    PLUMB_RETURN_IF_ERROR(parseStamp(where, line.tokens[0], &entry.rgb_timestamp_s));
+    entry.rgb_path = line.tokens[1];
+    PLUMB_RETURN_IF_ERROR(parseStamp(where, line.tokens[2], &entry.depth_timestamp_s));
+    entry.depth_path = line.tokens[3];
+    if (!out->empty()) {
+      PLUMB_RETURN_IF_ERROR(checkIncreasing(where, "rgb", out->back().rgb_timestamp_s,
+                                            previous_line, entry.rgb_timestamp_s));
+      PLUMB_RETURN_IF_ERROR(checkIncreasing(where, "depth", out->back().depth_timestamp_s,
+                                            previous_line, entry.depth_timestamp_s));
+    }
+    previous_line = line.number;
+    out->push_back(std::move(entry));
+  }
+  if (out->empty()) return Status::Error(list_path + ": empty list (no associations)");
+  return Status::Ok();
+}
+
+std::vector<TumFrameEntry> associateTumLists(const std::vector<TumListEntry>& rgb,
+                                             const std::vector<TumListEntry>& depth) {
+  std::vector<double> rgb_stamps, depth_stamps;
+  for (const TumListEntry& e : rgb) rgb_stamps.push_back(e.timestamp_s);
+  for (const TumListEntry& e : depth) depth_stamps.push_back(e.timestamp_s);
+  std::vector<TumFrameEntry> frames;
+  for (const IndexPair& pair : associateTimestamps(rgb_stamps, depth_stamps)) {
+    const TumListEntry& r = rgb[pair.first];
+    const TumListEntry& d = depth[pair.second];
+    frames.push_back({r.timestamp_s, r.path, d.timestamp_s, d.path});
+  }
+  return frames;
+}
+
+}  // namespace plumb

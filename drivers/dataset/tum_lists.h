@@ -1,0 +1,27 @@
+#pragma once
+// Readers of the TUM list files: rgb.txt / depth.txt (`timestamp filename`) and associations.txt
+// (`t_rgb rgb/X.png t_depth depth/Y.png`). Each checks that the list is not empty, every line
+// parses, and timestamps strictly increase; errors name the file and line.
+#include <string>
+#include <vector>
+
+#include "drivers/dataset/tum_dataset.h"
+#include "platform/status.h"
+
+namespace plumb {
+
+struct TumListEntry {
+  double timestamp_s = 0;
+  std::string path;  // relative to the dataset folder
+  int line = 0;      // line number in the list file (for later messages)
+};
+
+Status readTumImageList(const std::string& list_path, std::vector<TumListEntry>* out);
+
+Status readTumAssociations(const std::string& list_path, std::vector<TumFrameEntry>* out);
+
+// Pairs rgb and depth lists with the benchmark's rule (timestamp_association.h).
+std::vector<TumFrameEntry> associateTumLists(const std::vector<TumListEntry>& rgb,
+                                             const std::vector<TumListEntry>& depth);
+
+}  // namespace plumb

@@ -1,0 +1,150 @@
+#include "drivers/trajectory/trajectory_io.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+
+#include "drivers/common/text_lines.h"
+
+namespace plumb {
+namespace {
+
+std::string formatNumber(const char* format, double value) {
+  char text[64];
+  std::snprintf(text, sizeof(text), format, value);
+  return text;
+}
+
+// `# <timestamp> lost` as written by formatTumLine for a frame without a pose.
+bool parseLostMarker(const TextLine& line, double* timestamp) {
+  return line.is_comment && line.tokens.size() == 2 && line.tokens[1] == "lost" &&
+         parseDouble(line.tokens[0], timestamp) && std::isfinite(*timestamp);
+}
+
+Status parsePoseLine(const std::string& where, const TextLine& line,
+                     const TrajectoryReadOptions& options, StampedPose* pose, bool* normalised) {
+  if (line.tokens.size() != 8)
+    return Status::Error(where + ": expected 8 fields `timestamp tx ty tz qx qy qz qw`, got " +
+                         std::to_string(line.tokens.size()));
+  double v[8];
+  static const char* const kNames[8] = {"timestamp", "tx", "ty", "tz", "qx", "qy", "qz", "qw"};
+  for (int i = 0; i < 8; ++i) {
+    if (!parseDouble(line.tokens[i], &v[i]))
+      return Status::Error(where + ": " + kNames[i] + " '" + line.tokens[i] + "' is not a number");
+    if (!std::isfinite(v[i])) return Status::Error(where + ": " + kNames[i] + " is not finite");
+  }
+  Eigen::Quaterniond q_world_cam(v[7], v[4], v[5], v[6]);  // Eigen's constructor is (w, x, y, z)
+  const double norm = q_world_cam.norm();
+  if (norm < 1e-9) return Status::Error(where + ": zero quaternion");
+  if (std::abs(norm - 1.0) > options.quaternion_norm_tolerance)
+    return Status::Error(where + ": quaternion norm " + formatNumber("%.6g", norm) +
+                         " is not 1 (tolerance " +
+                         formatNumber("%g", options.quaternion_norm_tolerance) + ")");
+  *normalised = std::abs(norm - 1.0) > 1e-6;
+  q_world_cam.normalize();
+  pose->timestamp = v[0];
+  pose->T_world_cam.setIdentity();
+  pose->T_world_cam.linear() = q_world_cam.toRotationMatrix();
+  pose->T_world_cam.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
+  pose->valid = true;
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status readTumTrajectory(const std::string& path, std::vector<StampedPose>* out,
+                         const TrajectoryReadOptions& options, TrajectoryReadReport* report) {
+  out->clear();
+  TrajectoryReadReport local_report;
+  std::vector<TextLine> lines;
+  PLUMB_RETURN_IF_ERROR(readTextLines(path, &lines));
+  int previous_line = 0;
+  std::size_t valid_poses = 0;
+  for (const TextLine& line : lines) {
+    const std::string where = fileLine(path, line.number);
+    StampedPose pose;
+    if (line.is_comment) {
+      if (!parseLostMarker(line, &pose.timestamp) || !options.keep_lost_markers) continue;
+      pose.valid = false;
+    } else {
+      bool normalised = false;
+      PLUMB_RETURN_IF_ERROR(parsePoseLine(where, line, options, &pose, &normalised));
+      local_report.quaternions_normalised += normalised ? 1 : 0;
+    }
+    if (!out->empty()) {
+      const double previous = out->back().timestamp;
+      if (pose.timestamp < previous)
+        return Status::Error(where + ": non-monotonic timestamp " +
+                             formatNumber("%.6f", pose.timestamp) + " (previous " +
+                             formatNumber("%.6f", previous) + " on line " +
+                             std::to_string(previous_line) + ")");
+      if (pose.timestamp == previous) {
+        // The benchmark's dictionary keeps the later line; so do we, and count it.
+        ++local_report.duplicate_timestamps_replaced;
+        if (out->back().valid) --valid_poses;
+        out->pop_back();
+      }
+    }
+    valid_poses += pose.valid ? 1 : 0;
+    previous_line = line.number;
+    out->push_back(pose);
+  }
+  if (valid_poses == 0) return Status::Error(path + ": no poses (empty trajectory)");
+  if (report) *report = local_report;
+  return Status::Ok();
+}
+
+std::string formatTumLine(const StampedPose& pose) {
+  char text[256];
+  if (!pose.valid) {
+    std::snprintf(text, sizeof(text), "# %.6f lost", pose.timestamp);
+    return text;
+  }
+  const Eigen::Vector3d t = pose.T_world_cam.translation();
+  Eigen::Quaterniond q(pose.T_world_cam.rotation());
+  // q and -q are the same rotation; pick qw >= 0 so equal poses always print the same bytes.
+  if (q.w() < 0) q.coeffs() = -q.coeffs();
+  std::snprintf(text, sizeof(text), "%.6f %.9g %.9g %.9g %.9g %.9g %.9g %.9g", pose.timestamp,
+                t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+  return text;
+}
+
+Status writeTumTrajectory(const std::string& path, const std::vector<StampedPose>& poses) {
+  TumTrajectoryWriter writer;
+  PLUMB_RETURN_IF_ERROR(writer.open(path));
+  for (const StampedPose& pose : poses) PLUMB_RETURN_IF_ERROR(writer.append(pose));
+  return writer.close();
+}
+
+TumTrajectoryWriter::~TumTrajectoryWriter() {
+  if (file_) std::fclose(file_);
+}
+
+Status TumTrajectoryWriter::open(const std::string& path) {
+  if (file_) return Status::Error(path_ + ": trajectory writer already open");
+  path_ = path;
+  file_ = std::fopen(path.c_str(), "wb");
+  if (!file_) return Status::Error(path + ": cannot write trajectory (" + std::strerror(errno) + ")");
+  std::fputs("# plumb trajectory: timestamp tx ty tz qx qy qz qw (T_world_cam); "
+             "'# <timestamp> lost' = no pose\n",
+             file_);
+  return Status::Ok();
+}
+
+Status TumTrajectoryWriter::append(const StampedPose& pose) {
+  if (!file_) return Status::Error("trajectory writer is not open");
+  const std::string line = formatTumLine(pose);
+  if (std::fprintf(file_, "%s\n", line.c_str()) < 0) return Status::Error(path_ + ": write failed");
+  return Status::Ok();
+}
+
+Status TumTrajectoryWriter::close() {
+  if (!file_) return Status::Ok();
+  const bool failed = std::ferror(file_) != 0;
+  const bool close_failed = std::fclose(file_) != 0;
+  file_ = nullptr;
+  if (failed || close_failed) return Status::Error(path_ + ": write failed");
+  return Status::Ok();
+}
+
+}  // namespace plumb

@@ -1,0 +1,134 @@
+// plumb eval: ATE and RPE of an estimated trajectory against ground truth, by the TUM benchmark's
+// conventions (drivers/trajectory/evaluate.h), optionally with a PNG plot.
+#include <cstdio>
+#include <string>
+
+#include "drivers/trajectory/evaluate.h"
+#include "drivers/trajectory/trajectory_io.h"
+#include "drivers/trajectory/trajectory_plot.h"
+#include "tools/args.h"
+#include "tools/command.h"
+
+namespace plumb::tools {
+namespace {
+
+void printEvalUsage() {
+  std::printf(
+      "usage: plumb eval --gt GT.txt --est EST.txt [--plot out.png] [--json]\n"
+      "  Trajectories in TUM format (timestamp tx ty tz qx qy qz qw, T_world_cam).\n"
+      "  ATE: greedy unique association |dt| < 0.02 s, rigid alignment (no scale), RMSE in m.\n"
+      "  RPE: pairs ~1 s apart (benchmark evaluate_rpe, fixed delta 1 s): m/s and deg/s.\n"
+      "  --plot  write a PNG: top view of ground truth vs aligned estimate, x/y/z error over time\n"
+      "  --json  print one JSON object instead of text\n");
+}
+
+Status readTrajectory(const char* role, const std::string& path, std::vector<StampedPose>* poses,
+                      TrajectoryReadReport* report) {
+  return readTumTrajectory(path, poses, {}, report).withContext(std::string("reading ") + role);
+}
+
+void printJson(const std::string& gt, const std::string& est, const AteResult& ate,
+               const RpeResult* rpe, const std::string& plot) {
+  // Paths are printed verbatim apart from escaping the two characters JSON requires.
+  auto quoted = [](const std::string& s) {
+    std::string out = "\"";
+    for (char c : s) {
+      if (c == '"' || c == '\\') out += '\\';
+      out += c;
+    }
+    return out + "\"";
+  };
+  std::printf("{\"ground_truth\": %s, \"estimate\": %s,\n", quoted(gt).c_str(), quoted(est).c_str());
+  const ErrorStatistics& a = ate.translation_m;
+  std::printf(" \"ate\": {\"pairs\": %zu, \"rmse_m\": %.6f, \"mean_m\": %.6f, \"median_m\": %.6f, "
+              "\"max_m\": %.6f},\n",
+              ate.pairs, a.rmse, a.mean, a.median, a.max);
+  if (rpe) {
+    std::printf(" \"rpe\": {\"pairs\": %zu, \"delta_s\": 1.0, \"translation_rmse_m_per_s\": %.6f, "
+                "\"translation_mean_m_per_s\": %.6f, \"rotation_rmse_deg_per_s\": %.6f, "
+                "\"rotation_mean_deg_per_s\": %.6f}",
+                rpe->pairs, rpe->translation_m_per_s.rmse, rpe->translation_m_per_s.mean,
+                rpe->rotation_deg_per_s.rmse, rpe->rotation_deg_per_s.mean);
+  } else {
+    std::printf(" \"rpe\": null");
+  }
+  std::printf(",\n \"plot\": %s}\n", plot.empty() ? "null" : quoted(plot).c_str());
+}
+
+void printText(const AteResult& ate, const RpeResult* rpe, const std::string& rpe_note) {
+  const ErrorStatistics& a = ate.translation_m;
+  std::printf("ATE RMSE %.4f m over %zu pairs (mean %.4f, median %.4f, max %.4f m)\n", a.rmse,
+              ate.pairs, a.mean, a.median, a.max);
+  if (rpe) {
+    std::printf("RPE translation RMSE %.4f m/s, rotation RMSE %.4f deg/s over %zu pairs (delta 1 s)\n",
+                rpe->translation_m_per_s.rmse, rpe->rotation_deg_per_s.rmse, rpe->pairs);
+  } else {
+    std::printf("RPE not available: %s\n", rpe_note.c_str());
+  }
+}
+
+int runEval(int argc, char** argv) {
+  Args args(argc, argv, {"gt", "est", "plot"}, {"json"});
+  if (args.help()) {
+    printEvalUsage();
+    return 0;
+  }
+  if (!args.error().empty() || !args.positional().empty() || !args.has("gt") || !args.has("est")) {
+    std::fprintf(stderr, "plumb eval: %s\n",
+                 !args.error().empty()          ? args.error().c_str()
+                 : !args.positional().empty() ? ("unexpected argument " + args.positional()[0]).c_str()
+                                                : "--gt and --est are required");
+    printEvalUsage();
+    return 2;
+  }
+  const std::string gt_path = args.get("gt"), est_path = args.get("est"), plot_path = args.get("plot");
+  std::vector<StampedPose> ground_truth, estimate;
+  TrajectoryReadReport gt_report, est_report;
+  for (const Status& st : {readTrajectory("ground truth", gt_path, &ground_truth, &gt_report),
+                           readTrajectory("estimate", est_path, &estimate, &est_report)}) {
+    if (!st.ok()) {
+      std::fprintf(stderr, "plumb eval: %s\n", st.message().c_str());
+      return 1;
+    }
+  }
+  // Not silent: the benchmark keeps the later of two equal stamps, we say that we did too.
+  if (gt_report.duplicate_timestamps_replaced + est_report.duplicate_timestamps_replaced > 0)
+    std::fprintf(stderr, "plumb eval: note: %d duplicate timestamp(s) in %s, %d in %s; kept the later line\n",
+                 gt_report.duplicate_timestamps_replaced, gt_path.c_str(),
+                 est_report.duplicate_timestamps_replaced, est_path.c_str());
+
+  AteResult ate;
+  Status st = evaluateAte(ground_truth, estimate, {}, &ate);
+  if (!st.ok()) {
+    std::fprintf(stderr, "plumb eval: %s vs %s: %s\n", est_path.c_str(), gt_path.c_str(), st.message().c_str());
+    return 1;
+  }
+  // A short estimate (< 1 s) has no RPE pairs: report that, ATE is still meaningful.
+  RpeResult rpe;
+  const Status rpe_status = evaluateRpe(ground_truth, estimate, {}, &rpe);
+
+  if (!plot_path.empty()) {
+    TrajectoryPlotOptions plot_options;
+    char title[160];
+    std::snprintf(title, sizeof(title), "ATE RMSE %.4f m over %zu pairs", ate.translation_m.rmse, ate.pairs);
+    plot_options.title = title;
+    st = writeTrajectoryPlot(plot_path, ate, plot_options);
+    if (!st.ok()) {
+      std::fprintf(stderr, "plumb eval: %s\n", st.message().c_str());
+      return 1;
+    }
+  }
+  if (args.has("json")) {
+    printJson(gt_path, est_path, ate, rpe_status.ok() ? &rpe : nullptr, plot_path);
+  } else {
+    printText(ate, rpe_status.ok() ? &rpe : nullptr, rpe_status.message());
+    if (!plot_path.empty()) std::printf("plot: %s\n", plot_path.c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+}  // namespace plumb::tools
+
+PLUMB_COMMAND(eval, "ATE/RPE of an estimated trajectory against ground truth (TUM format)",
+              plumb::tools::runEval);
