@@ -1,0 +1,36 @@
+#pragma once
+// ImagePyramid: the grey image at num_levels scales (level i is 1/scale^i of level 0) plus a
+// Gaussian-blurred copy of every level for the binary descriptors.
+//
+// All levels live as ROIs of ONE buffer whose row stride is level 0's width, so a pixel offset
+// (dy * stride + dx) means the same thing on every level: the rotated-BRIEF and FAST offset
+// tables are computed once. Buffers are allocated in the constructor; build() only writes.
+#include <array>
+
+#include <opencv2/core.hpp>
+
+#include "pipeline/capacities.h"
+
+namespace plumb {
+
+class ImagePyramid {
+ public:
+  ImagePyramid(int width, int height, int num_levels, float scale_factor);
+
+  // grey: CV_8UC1 of the level-0 size. Fills every level and the blurred levels.
+  void build(const cv::Mat& grey);
+
+  int numLevels() const { return num_levels_; }
+  float scale(int level) const { return scales_[level]; }  // scale_factor^level
+  const cv::Mat& level(int i) const { return levels_[i]; }
+  const cv::Mat& blurred(int i) const { return blurred_levels_[i]; }
+  int stride() const { return static_cast<int>(buffer_.step[0]); }  // bytes per row, every level
+
+ private:
+  int num_levels_;
+  std::array<float, kPyramidLevels> scales_{};
+  cv::Mat buffer_, blurred_buffer_;
+  std::array<cv::Mat, kPyramidLevels> levels_, blurred_levels_;
+};
+
+}  // namespace plumb

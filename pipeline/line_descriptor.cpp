@@ -1,0 +1,74 @@
+#include "pipeline/line_descriptor.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace plumb {
+namespace {
+
+constexpr int kBands = 9;
+constexpr int kStats = 8;  // 4 LBD sums x 2 halves of the segment
+
+}  // namespace
+
+void computeLineDescriptor(const cv::Mat& image, const cv::Point2f& start, const cv::Point2f& end,
+                           const LineDescriptorOptions& options, Descriptor256& out) {
+  std::array<std::array<float, kStats>, kBands> band{};
+  const float dx = end.x - start.x, dy = end.y - start.y;
+  const float length = std::sqrt(dx * dx + dy * dy);
+  out.words = {0, 0, 0, 0};
+  if (length < 1e-3f) return;
+  const float ux = dx / length, uy = dy / length;  // along the segment
+  const float nx = -uy, ny = ux;                   // across it
+  const int w = std::max(1, options.band_width);
+  const int rows = kBands * w;
+  const int half_rows = rows / 2;
+  const int positions = std::clamp(static_cast<int>(length), 4, std::max(4, options.max_positions));
+  const float sigma = 0.5f * rows;  // LBD's global Gaussian across the region
+  const int x_max = image.cols - 2, y_max = image.rows - 2;
+  const int stride = static_cast<int>(image.step[0]);
+  const uint8_t* data = image.ptr<uint8_t>(0);
+
+  for (int r = 0; r < rows; ++r) {
+    const float offset = static_cast<float>(r - half_rows);
+    const float weight = std::exp(-0.5f * offset * offset / (sigma * sigma));
+    std::array<float, kStats>& stats = band[r / w];
+    for (int k = 0; k < positions; ++k) {
+      const float t = (k + 0.5f) / positions;
+      const int x = static_cast<int>(std::lround(start.x + t * dx + offset * nx));
+      const int y = static_cast<int>(std::lround(start.y + t * dy + offset * ny));
+      if (x < 1 || y < 1 || x > x_max || y > y_max) continue;
+      const uint8_t* p = data + y * stride + x;
+      const float gx = static_cast<float>(p[1] - p[-1]);
+      const float gy = static_cast<float>(p[stride] - p[-stride]);
+      const float g_across = weight * (gx * nx + gy * ny);
+      const float g_along = weight * (gx * ux + gy * uy);
+      float* s = stats.data() + (2 * k >= positions ? 4 : 0);
+      if (g_across > 0) s[0] += g_across; else s[1] -= g_across;
+      if (g_along > 0) s[2] += g_along; else s[3] -= g_along;
+    }
+  }
+
+  int bit = 0;
+  auto put = [&](bool value) {
+    if (value) out.words[bit >> 6] |= 1ULL << (bit & 63);
+    ++bit;
+  };
+  for (int i = 0; i < kBands; ++i) {
+    for (int j = i + 1; j < kBands && j - i <= 4; ++j) {
+      for (int s = 0; s < kStats; ++s) put(band[i][s] > band[j][s]);
+    }
+  }
+  for (int i = 0; i < kBands - 1; ++i) {  // 8 bands x 6 = 48 bits
+    const std::array<float, kStats>& b = band[i];
+    put(b[0] > b[1]);
+    put(b[4] > b[5]);
+    put(b[2] > b[3]);
+    put(b[6] > b[7]);
+    put(b[0] > b[4]);
+    put(b[1] > b[5]);
+  }
+}
+
+}  // namespace plumb

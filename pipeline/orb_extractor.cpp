@@ -1,0 +1,106 @@
+#include "pipeline/orb_extractor.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace plumb {
+namespace {
+
+constexpr int kRejected = 1 << 30;
+// FAST corners kept per level after suppression; a 640x480 level rarely exceeds ~15k at
+// threshold 7, and a full buffer only drops corners at the bottom of the image.
+constexpr int kMaxCornersPerLevel = 40000;
+
+}  // namespace
+
+OrbExtractor::OrbExtractor(const PinholeCamera& camera, const ExtractorOptions& options)
+    : camera_(camera), options_(options),
+      pyramid_(camera.width, camera.height, options.num_levels, options.scale_factor),
+      fast_(camera.width, camera.height, kMaxCornersPerLevel),
+      describer_(pyramid_.stride()) {
+  ranked_.resize(kMaxCornersPerLevel);
+  // Geometric share per level: n0 * (1/s)^i, summing to num_features (ORB-SLAM's split).
+  const int levels = pyramid_.numLevels();
+  const double inv = 1.0 / options.scale_factor;
+  const double n0 = options.num_features * (1 - inv) / (1 - std::pow(inv, levels));
+  int assigned = 0;
+  for (int i = 0; i < levels - 1; ++i) {
+    features_per_level_[i] = static_cast<int>(std::lround(n0 * std::pow(inv, i)));
+    assigned += features_per_level_[i];
+  }
+  features_per_level_[levels - 1] = std::max(0, options.num_features - assigned);
+}
+
+void OrbExtractor::extract(const cv::Mat& grey, FrameFeatures& out) {
+  const auto t0 = std::chrono::steady_clock::now();
+  pyramid_.build(grey);
+  pyramid_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  int carry = 0;  // features a level could not provide move to the next one
+  const int max_total = std::min<int>(options_.num_features, kMaxKeypoints);
+  for (int level = 0; level < pyramid_.numLevels(); ++level) {
+    const int before = static_cast<int>(out.keypoints.size());
+    const int wanted = std::min(features_per_level_[level] + carry, max_total - before);
+    if (wanted <= 0) break;
+    selectOnLevel(level, wanted, out);
+    carry = wanted - (static_cast<int>(out.keypoints.size()) - before);
+  }
+}
+
+void OrbExtractor::selectOnLevel(int level, int wanted, FrameFeatures& out) {
+  const cv::Mat& image = pyramid_.level(level);
+  const int border = OrbDescriber::kBorder;
+  const int num = fast_.detect(image, options_.fast_threshold_low, border);
+  const int cell = std::max(8, options_.cell_size_px);
+  const int cols = std::max(1, (image.cols - 2 * border + cell - 1) / cell);
+
+  const FastCorner* corners = fast_.corners();
+  for (int i = 0; i < num; ++i) {
+    ranked_[i].corner = corners[i];
+    ranked_[i].cell = ((corners[i].y - border) / cell) * cols + (corners[i].x - border) / cell;
+  }
+  auto stronger = [](const FastCorner& a, const FastCorner& b) {
+    if (a.score != b.score) return a.score > b.score;
+    return a.y != b.y ? a.y < b.y : a.x < b.x;  // deterministic tie-break
+  };
+  auto begin = ranked_.begin(), end = ranked_.begin() + num;
+  std::sort(begin, end, [&](const RankedCorner& a, const RankedCorner& b) {
+    return a.cell != b.cell ? a.cell < b.cell : stronger(a.corner, b.corner);
+  });
+  const int high = options_.fast_threshold_high;
+  for (int i = 0, cell_first = 0; i < num; ++i) {
+    if (i == 0 || ranked_[i].cell != ranked_[i - 1].cell) cell_first = i;
+    const bool cell_has_strong = ranked_[cell_first].corner.score > high;
+    const bool weak = ranked_[i].corner.score <= high;
+    ranked_[i].rank = (cell_has_strong && weak) ? kRejected : i - cell_first;
+  }
+  const int take = std::min(wanted, num);
+  std::partial_sort(begin, begin + take, end, [&](const RankedCorner& a, const RankedCorner& b) {
+    return a.rank != b.rank ? a.rank < b.rank : stronger(a.corner, b.corner);
+  });
+
+  const float scale = pyramid_.scale(level);
+  const uint8_t* level_origin = image.ptr<uint8_t>(0);
+  const uint8_t* blurred_origin = pyramid_.blurred(level).ptr<uint8_t>(0);
+  const int stride = pyramid_.stride();
+  for (int i = 0; i < take; ++i) {
+    if (ranked_[i].rank == kRejected) break;
+    const FastCorner& c = ranked_[i].corner;
+    KeypointObservation* kp = out.keypoints.emplace_back();
+    Descriptor256* descriptor = out.keypoint_descriptors.emplace_back();
+    if (kp == nullptr || descriptor == nullptr) {  // capacity reached: keep the arrays parallel
+      if (kp != nullptr) out.keypoints.pop_back();
+      if (descriptor != nullptr) out.keypoint_descriptors.pop_back();
+      break;
+    }
+    const int offset = c.y * stride + c.x;
+    kp->angle_deg = describer_.orientationDeg(level_origin + offset);
+    describer_.describe(blurred_origin + offset, kp->angle_deg, *descriptor);
+    kp->px = Eigen::Vector2f(c.x * scale, c.y * scale);
+    kp->px_undist = camera_.undistortPoint(kp->px.x(), kp->px.y()).cast<float>();
+    kp->response = c.score;
+    kp->octave = static_cast<int8_t>(level);
+  }
+}
+
+}  // namespace plumb

@@ -1,0 +1,53 @@
+#pragma once
+// OrbExtractor: ORB keypoints spread over the image, written into FrameFeatures.
+//
+// Per pyramid level: FAST-9 at the low threshold with 3x3 suppression; the level's share of
+// num_features (geometric in the scale, as ORB-SLAM) is filled round-robin over grid cells
+// (every cell's best corner first, then every cell's second best, ...), each round strongest
+// first. A cell that has corners above the high threshold uses only those; a cell that has none
+// falls back to the low threshold, so weak-texture regions still get keypoints (ORB-SLAM's
+// adaptive FAST threshold, without running FAST twice). Then orientation by intensity centroid,
+// rotated BRIEF on the blurred level, and undistortion of the keypoint coordinate.
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "pipeline/camera.h"
+#include "pipeline/extractor_options.h"
+#include "pipeline/frame_features.h"
+#include "pipeline/image_pyramid.h"
+#include "pipeline/orb_descriptor.h"
+#include "pipeline/orb_fast.h"
+
+namespace plumb {
+
+class OrbExtractor {
+ public:
+  OrbExtractor(const PinholeCamera& camera, const ExtractorOptions& options);
+
+  // grey: CV_8UC1 camera-sized. Builds the pyramid, appends keypoints + descriptors to `out`.
+  void extract(const cv::Mat& grey, FrameFeatures& out);
+
+  const ImagePyramid& pyramid() const { return pyramid_; }
+  double lastPyramidMs() const { return pyramid_ms_; }
+
+ private:
+  struct RankedCorner {
+    FastCorner corner;
+    int cell = 0;
+    int rank = 0;  // position within its cell, strongest first; kRejected when below the cell's bar
+  };
+
+  void selectOnLevel(int level, int wanted, FrameFeatures& out);
+
+  PinholeCamera camera_;
+  ExtractorOptions options_;
+  ImagePyramid pyramid_;
+  FastDetector fast_;
+  OrbDescriber describer_;
+  std::array<int, kPyramidLevels> features_per_level_{};
+  std::vector<RankedCorner> ranked_;  // capacity fixed in the constructor, never grows
+  double pyramid_ms_ = 0;
+};
+
+}  // namespace plumb
