@@ -32,17 +32,20 @@
 // grown by 1 / max(1/3, 1 - (2 rho - 1)^3) on success and shrunk by a doubling factor on failure).
 // A rejected step re-eliminates from the stored linearisation without re-evaluating residuals.
 //
-// DEGENERATE LANDMARKS. A landmark whose (damped) 3x3 block is not safely positive definite (one
-// line observation, all observations behind the camera, a point at a camera centre) is held fixed
-// for that linearisation: its observations still constrain the poses like pose-only factors,
-// it gets no step, and it never produces Inf or NaN. Observations with the point behind the camera
-// (Z <= 0) are dropped from the linearisation and flagged outliers.
+// DEGENERATE LANDMARKS. Each 3x3 block is inverted by Cholesky when well conditioned, otherwise
+// by a pseudo-inverse on its range (eigenvalues above landmark_singular_threshold * the largest).
+// That is exact, not a hack: a line-guidance point seen only on lines can slide along its 3D line
+// without changing any residual, so the null direction of H_ll is also a null direction of H_lp;
+// it gets no step and carries no pose information. A zero or non-finite block (every observation
+// behind the camera, a point at a camera centre) holds the landmark fixed for that linearisation.
+// Nothing produces Inf or NaN. Observations with the point behind the camera (Z <= 0) are dropped
+// from the linearisation and flagged outliers.
 //
 // COVARIANCE (paper eq. 12). At the current estimate, undamped, with the same IRLS weights:
 //   C = (H_A - H_B H_C^-1 H_B^T)^-1 = S^-1,   H_A = H_pp, H_B = H_pl, H_C = H_ll,
 // the joint covariance of the K optimised poses (landmarks marginalised). covariance(kf) is the
 // 6x6 diagonal block; fullCovariance() the whole 6K x 6K matrix, rows/cols ordered by
-// poseVariableIndex(). Landmarks with a singular H_C block are left out (treated as fixed).
+// poseVariableIndex(). Rank-deficient H_C blocks enter through their pseudo-inverse (above).
 //
 // MEMORY. reserve() allocates every buffer once for the given maxima; add*(), solve(),
 // computeCovariance() and computeStep() never touch the heap (proved by a test hooking operator
@@ -77,8 +80,9 @@ struct LocalBaOptions {
   double min_relative_decrease = 1e-3;  // accept a step when actual / predicted exceeds this
   // Stop when |cost change| / cost of an accepted step falls below this (0: run all iterations).
   double function_tolerance = 1e-6;
-  // Relative pivot below which a 3x3 landmark block counts as singular (landmark held fixed).
-  double landmark_singular_threshold = 1e-12;
+  // Eigenvalues of a 3x3 landmark block below this fraction of its largest one are treated as
+  // exact zeros (pseudo-inverse; see DEGENERATE LANDMARKS above).
+  double landmark_singular_threshold = 1e-10;
 };
 
 enum class LocalBaStatus {
@@ -190,9 +194,13 @@ class LocalBundleAdjuster {
   int addObservation(int keyframe, int landmark, ObservationKind kind, const Eigen::Vector3d& z,
                      const Eigen::Matrix3d& information);
   void buildStructure();
-  void linearize(const LocalBaOptions& options);
+  // IRLS normal equations at the current estimate into the per-keyframe / per-landmark /
+  // per-observation blocks; returns the robust cost of the valid observations.
+  double linearize(const LocalBaOptions& options);
   bool solveDamped(const LocalBaOptions& options, double lambda);
-  double evaluateCost(const LocalBaOptions& options, bool candidate, bool* all_valid) const;
+  bool evaluateChi2(const Observation& obs, const Eigen::Isometry3d& T_cam_world,
+                    const Eigen::Vector3d& P_world, double* chi2) const;
+  double candidateCost(const LocalBaOptions& options, bool* all_valid) const;
   double modelCostReduction(double lambda) const;
   void updateOutlierFlags(const LocalBaOptions& options, LocalBaSummary* summary);
 
