@@ -1,0 +1,113 @@
+// Real-time mode on a VirtualClock: pacing and dropping are simulated event by event, so a stage
+// made slow (it advances the virtual clock) drops exactly the frames worked out by hand below.
+#include <gtest/gtest.h>
+
+#include "runtime/stage_runner.h"
+#include "toy_pipeline.h"
+
+namespace plumb::runtime {
+namespace {
+
+using testing::FoldStage;
+using testing::MixStage;
+using testing::ToyFrame;
+using testing::ToySource;
+
+constexpr int64_t kMs = 1'000'000;
+
+struct Simulated {
+  std::vector<uint64_t> processed;  // frame indices that reached the last stage
+  std::vector<uint64_t> dropped;    // from the source's trace track
+  RunReport report;
+  int64_t end_time_ns = 0;
+  std::size_t free_slots_after = 0;
+};
+
+Simulated simulate(uint64_t frames, int64_t period_ns, std::size_t slots, int64_t mix_cost_ns,
+                   int64_t fold_cost_ns) {
+  VirtualClock clock;
+  ToySource source(frames, period_ns);
+  MixStage mix(&clock, mix_cost_ns);
+  FoldStage fold(frames, -1, &clock, fold_cost_ns);
+  RunOptions options;
+  options.mode = RunMode::kRealtime;
+  options.slot_count = slots;
+  options.clock = &clock;
+  StageRunner<ToyFrame> runner(source, {&mix, &fold}, options);
+  Simulated result;
+  const Status status = runner.run();
+  EXPECT_TRUE(status.ok()) << status.message();
+  result.processed = fold.frameIndices();
+  for (const TraceRecord& r : runner.trace()[0].records()) {
+    if (r.kind == TraceRecord::Kind::kDrop) result.dropped.push_back(r.frame_index);
+  }
+  result.report = runner.report();
+  result.end_time_ns = clock.nowNs();
+  result.free_slots_after = runner.pool().freeCount();
+  EXPECT_EQ(source.consumed(), frames) << "dropped frames must still be consumed (skipped)";
+  return result;
+}
+
+TEST(RealtimeSimulation, ASlowStageDropsExactlyTheFramesThatFindNoFreeSlot) {
+  // Frames every 10 ms, 2 slots, "mix" takes 25 ms. By hand (times in ms):
+  //   f0 @0  slot free        mix 0-25    released 25
+  //   f1 @10 1 in flight      mix 25-50   released 50
+  //   f2 @20 f0, f1 in flight -> drop
+  //   f3 @30 f0 back at 25    mix 50-75   released 75
+  //   f4 @40 f1, f3           -> drop
+  //   f5 @50 f1 back at 50    mix 75-100  released 100   (a release at t serves a capture at t)
+  //   f6 @60, f7 @70          -> drop, drop
+  //   f8 @80 f3 back at 75    mix 100-125
+  //   f9 @90 f5, f8           -> drop
+  const Simulated r = simulate(10, 10 * kMs, 2, 25 * kMs, 0);
+  EXPECT_EQ(r.processed, (std::vector<uint64_t>{0, 1, 3, 5, 8}));
+  EXPECT_EQ(r.dropped, (std::vector<uint64_t>{2, 4, 6, 7, 9}));
+  EXPECT_EQ(r.report.frames_dropped, 5u);
+  EXPECT_EQ(r.report.frames_completed, 5u);
+  // End to end (done - sensor time): 25, 40, 45, 50, 45 ms.
+  EXPECT_EQ(r.report.end_to_end.count(), 5u);
+  EXPECT_EQ(r.report.end_to_end.maxNs(), 50 * kMs);
+  EXPECT_EQ(r.report.end_to_end.minNs(), 25 * kMs);
+  EXPECT_DOUBLE_EQ(r.report.end_to_end.meanNs(), 41.0 * kMs);
+  EXPECT_EQ(r.report.stages[1].latency.maxNs(), 25 * kMs);
+  EXPECT_EQ(r.end_time_ns, 125 * kMs);
+  EXPECT_EQ(r.free_slots_after, 2u);
+}
+
+TEST(RealtimeSimulation, StagesOverlapLikeThreads) {
+  // Two 8 ms stages at 10 ms per frame: a frame is in flight 16 ms, but mix works on frame n+1
+  // while fold works on frame n, so two slots suffice and nothing drops.
+  const Simulated r = simulate(30, 10 * kMs, 2, 8 * kMs, 8 * kMs);
+  EXPECT_TRUE(r.dropped.empty());
+  EXPECT_EQ(r.report.frames_completed, 30u);
+  EXPECT_EQ(r.report.end_to_end.minNs(), 16 * kMs);
+  EXPECT_EQ(r.report.end_to_end.maxNs(), 16 * kMs);
+  EXPECT_EQ(r.end_time_ns, 29 * 10 * kMs + 16 * kMs);
+}
+
+TEST(RealtimeSimulation, OneSlotMeansOneFrameInFlight) {
+  // Same stages, one slot: each frame holds it for 16 ms, so every other frame finds it taken.
+  const Simulated r = simulate(10, 10 * kMs, 1, 8 * kMs, 8 * kMs);
+  EXPECT_EQ(r.processed, (std::vector<uint64_t>{0, 2, 4, 6, 8}));
+  EXPECT_EQ(r.dropped, (std::vector<uint64_t>{1, 3, 5, 7, 9}));
+}
+
+TEST(RealtimeSimulation, FastEnoughStagesDropNothingAndLatencyIsTheirCost) {
+  const Simulated r = simulate(100, 33 * kMs, 4, 5 * kMs, 7 * kMs);
+  EXPECT_TRUE(r.dropped.empty());
+  EXPECT_EQ(r.report.frames_completed, 100u);
+  EXPECT_EQ(r.report.end_to_end.maxNs(), 12 * kMs);
+  EXPECT_EQ(r.report.end_to_end.percentileNs(0.99), 12 * kMs);
+}
+
+TEST(RealtimeSimulation, IsReproducible) {
+  const Simulated a = simulate(200, 10 * kMs, 3, 13 * kMs, 9 * kMs);
+  const Simulated b = simulate(200, 10 * kMs, 3, 13 * kMs, 9 * kMs);
+  EXPECT_EQ(a.processed, b.processed);
+  EXPECT_EQ(a.dropped, b.dropped);
+  EXPECT_FALSE(a.dropped.empty());  // 13 ms per frame cannot keep up with 10 ms
+  EXPECT_EQ(a.processed.size() + a.dropped.size(), 200u);
+}
+
+}  // namespace
+}  // namespace plumb::runtime
