@@ -1,0 +1,65 @@
+#pragma once
+// FrameRenderer: noise-free colour and depth of a SceneModel seen from one camera pose.
+//
+// Two passes over preallocated buffers (no allocation per frame):
+//  1. Rasterise every front-facing quad into a z-buffer of (depth, quad id). Each quad is clipped
+//     to the near plane, projected, and filled span by span; depth at a pixel centre is the exact
+//     ray-plane intersection z = d / (n . r), so depth is exact up to float rounding (no
+//     interpolation error, which the reprojection test relies on).
+//  2. Shade: texture (bilinear) x (ambient + sun + soft lamp) at the pixel centre. Pixels whose
+//     4-neighbours carry another quad id lie on a silhouette or crease: they are supersampled
+//     3x3 by ray casting against the quads of their 3x3 neighbourhood, so edges are anti-aliased
+//     and the line detector sees clean straight segments. Depth stays the centre sample (a real
+//     sensor does not blend depths either).
+// Shading is view-independent (Lambert), so a surface point has the same colour in every frame.
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "drivers/synth/scene_model.h"
+#include "pipeline/camera.h"
+
+namespace plumb::synth {
+
+class FrameRenderer {
+ public:
+  // Keeps references to model and camera (both must outlive the renderer); allocates all buffers.
+  FrameRenderer(const SceneModel& model, const PinholeCamera& camera);
+
+  void render(const Eigen::Isometry3d& T_world_cam);
+
+  // Results of the last render: linear colour (BGR, 0..255, may exceed 255 slightly before
+  // quantisation) and depth z in metres along the optical axis (+inf where nothing was hit).
+  const cv::Mat& colour() const { return colour_bgr_; }  // CV_32FC3
+  const cv::Mat& depth() const { return depth_m_; }       // CV_32FC1
+  int edgePixelCount() const { return edge_pixels_; }     // pixels supersampled in the last render
+
+ private:
+  // A quad moved into the camera frame for the current pose.
+  struct QuadInCamera {
+    Eigen::Vector3d origin, axis_u, axis_v, normal;
+    double plane_offset = 0;  // plane: normal . X = plane_offset (< 0 when facing the camera)
+    bool facing = false;
+  };
+
+  void transformQuads(const Eigen::Isometry3d& T_world_cam);
+  void rasteriseQuad(int quad_index);
+  void shadePixels();
+  // Nearest quad among `candidates` hit by the ray through (u, v); -1 if none. Sets *z.
+  int castRay(double u, double v, const int* candidates, int count, double* z) const;
+  cv::Vec3f shadePoint(int quad_index, const Eigen::Vector3d& P_cam) const;
+  cv::Vec3f sampleTexture(const SurfaceTexture& texture, double s_m, double t_m) const;
+
+  const SceneModel& model_;
+  const PinholeCamera& camera_;
+  std::vector<QuadInCamera> quads_cam_;
+  std::vector<double> ray_x_, ray_y_;  // (u - cx) / fx per column, (v - cy) / fy per row
+  std::vector<int32_t> quad_id_;       // per pixel, -1 = nothing
+  Eigen::Vector3d lamp_cam_;
+  cv::Mat colour_bgr_, depth_m_;
+  int edge_pixels_ = 0;
+};
+
+}  // namespace plumb::synth

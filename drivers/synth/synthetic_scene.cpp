@@ -1,0 +1,139 @@
+// SyntheticScene: presets, validation, and the glue between room, path, renderer and sensor model.
+#include "drivers/synth/synthetic_scene.h"
+
+#include <cmath>
+
+#include "drivers/synth/camera_path.h"
+#include "drivers/synth/frame_renderer.h"
+#include "drivers/synth/room_layout.h"
+#include "drivers/synth/sensor_model.h"
+#include "drivers/synth/synth_random.h"
+
+namespace plumb {
+
+namespace {
+
+constexpr double kFirstTimestamp = 1000.0;
+
+struct Preset {
+  const char* name;
+  bool textured;
+  double rotation_scale;
+};
+constexpr Preset kPresets[] = {
+    {"textured", true, 1.0},
+    {"low_texture", false, 1.0},
+    {"fast_rotation", true, 2.5},
+};
+
+const Preset* findPreset(const std::string& name) {
+  for (const Preset& p : kPresets)
+    if (name == p.name) return &p;
+  return nullptr;
+}
+
+}  // namespace
+
+Status validate(const SynthOptions& o) {
+  if (!findPreset(o.preset))
+    return Status::Error("synth: unknown preset '" + o.preset + "' (use textured, low_texture or fast_rotation)");
+  if (o.frames <= 0) return Status::Error("synth: frames must be positive (got " + std::to_string(o.frames) + ")");
+  if (!std::isfinite(o.fps) || o.fps <= 0) return Status::Error("synth: fps must be a positive number");
+  if (!std::isfinite(o.loop_period_s) || o.loop_period_s <= 0)
+    return Status::Error("synth: loop_period_s must be a positive number");
+  if (!std::isfinite(o.pixel_noise_sigma) || o.pixel_noise_sigma < 0)
+    return Status::Error("synth: pixel noise sigma must be >= 0");
+  if (!std::isfinite(o.depth_noise_k) || o.depth_noise_k < 0)
+    return Status::Error("synth: depth noise k must be >= 0");
+  const double max_representable_m = 65535.0 / synthCamera().depth_factor;
+  if (!(o.min_depth_m >= 0 && o.min_depth_m < o.max_depth_m && o.max_depth_m <= max_representable_m))
+    return Status::Error("synth: need 0 <= min_depth_m < max_depth_m <= " + std::to_string(max_representable_m));
+  return Status::Ok();
+}
+
+PinholeCamera synthCamera() {
+  PinholeCamera camera;
+  camera.fx = 525.0;
+  camera.fy = 525.0;
+  camera.cx = 319.5;
+  camera.cy = 239.5;
+  camera.width = 640;
+  camera.height = 480;
+  camera.depth_factor = 5000.0;
+  return camera;
+}
+
+class SyntheticSceneImpl {
+ public:
+  explicit SyntheticSceneImpl(const SynthOptions& options)
+      : options_(options),
+        camera_(synthCamera()),
+        model_(synth::buildRoom(layoutOptions(options))),
+        path_(pathOptions(options)),
+        renderer_(model_, camera_) {
+    sensor_.pixel_noise_sigma = options.pixel_noise_sigma;
+    sensor_.depth_noise = options.depth_noise;
+    sensor_.depth_noise_k = options.depth_noise_k;
+    sensor_.depth_edge_holes = options.depth_edge_holes;
+    sensor_.min_depth_m = options.min_depth_m;
+    sensor_.max_depth_m = options.max_depth_m;
+    sensor_.depth_factor = camera_.depth_factor;
+    noise_seed_ = synth::mix64(options.seed ^ 0x4e6f697365ULL);
+  }
+
+  static synth::RoomLayoutOptions layoutOptions(const SynthOptions& options) {
+    synth::RoomLayoutOptions layout;
+    layout.textured = findPreset(options.preset)->textured;
+    layout.seed = options.seed;
+    return layout;
+  }
+  static synth::CameraPathOptions pathOptions(const SynthOptions& options) {
+    synth::CameraPathOptions path;
+    path.seed = options.seed;
+    path.period_s = options.loop_period_s;
+    path.rotation_scale = findPreset(options.preset)->rotation_scale;
+    return path;
+  }
+
+  SynthOptions options_;
+  PinholeCamera camera_;
+  synth::SceneModel model_;
+  synth::CameraPath path_;
+  synth::FrameRenderer renderer_;  // scratch buffers: why render() is not reentrant
+  synth::SensorModelOptions sensor_;
+  uint64_t noise_seed_ = 0;
+};
+
+SyntheticScene::SyntheticScene(std::unique_ptr<SyntheticSceneImpl> impl) : impl_(std::move(impl)) {}
+SyntheticScene::~SyntheticScene() = default;
+
+Status SyntheticScene::create(const SynthOptions& options, std::unique_ptr<SyntheticScene>* out) {
+  PLUMB_RETURN_IF_ERROR(validate(options));
+  out->reset(new SyntheticScene(std::make_unique<SyntheticSceneImpl>(options)));
+  return Status::Ok();
+}
+
+const SynthOptions& SyntheticScene::options() const { return impl_->options_; }
+const PinholeCamera& SyntheticScene::camera() const { return impl_->camera_; }
+int SyntheticScene::numFrames() const { return impl_->options_.frames; }
+
+double SyntheticScene::timestamp(int i) const { return kFirstTimestamp + i / impl_->options_.fps; }
+
+Eigen::Isometry3d SyntheticScene::T_world_cam(int i) const {
+  return impl_->path_.T_world_cam(i / impl_->options_.fps);
+}
+
+Status SyntheticScene::render(int i, RgbdImage& out) const {
+  if (i < 0) return Status::Error("synth: frame index must be >= 0 (got " + std::to_string(i) + ")");
+  SyntheticSceneImpl& impl = *impl_;
+  impl.renderer_.render(T_world_cam(i));
+  synth::quantiseColour(impl.renderer_.colour(), impl.sensor_, impl.noise_seed_, i, out.bgr);
+  synth::quantiseDepth(impl.renderer_.depth(), impl.sensor_, impl.noise_seed_, i, out.depth_raw);
+  out.sequence = static_cast<uint64_t>(i);
+  out.timestamp_s = timestamp(i);
+  out.depth_timestamp_s = out.timestamp_s;
+  out.depth_factor = impl.camera_.depth_factor;
+  return Status::Ok();
+}
+
+}  // namespace plumb
