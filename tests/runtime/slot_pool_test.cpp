@@ -41,7 +41,7 @@ TEST(SlotPool, SlotsAreCreatedOnceAndKeepTheirAddresses) {
 TEST(SlotPool, ThreadedCirculationKeepsOwnershipExclusive) {
   // The source acquires and writes a slot, the sink checks and releases it: a slot written by
   // both at once, or lost, shows up as a wrong value or a hang.
-  constexpr int kFrames = 50'000;
+  constexpr int kFrames = 20'000;
   SlotPool<uint64_t> pool(4);
   SpscRing<SlotIndex> to_sink(8);
   int wrong = 0;

@@ -1,0 +1,43 @@
+#include "runtime/json_reader.h"
+
+#include <gtest/gtest.h>
+
+namespace plumb::runtime {
+namespace {
+
+TEST(JsonReader, ParsesEveryKindOfValue) {
+  JsonValue v;
+  ASSERT_TRUE(parseJson(R"( {"a": [1, -2.5e3, true, false, null], "s": "x\"y\u0041\n", "o": {}} )", &v).ok());
+  ASSERT_EQ(v.type, JsonValue::Type::kObject);
+  const JsonValue* a = v.find("a");
+  ASSERT_NE(a, nullptr);
+  ASSERT_EQ(a->items.size(), 5u);
+  EXPECT_EQ(a->items[0].number, 1.0);
+  EXPECT_EQ(a->items[1].number, -2500.0);
+  EXPECT_TRUE(a->items[2].boolean);
+  EXPECT_EQ(a->items[3].type, JsonValue::Type::kBool);
+  EXPECT_EQ(a->items[4].type, JsonValue::Type::kNull);
+  EXPECT_EQ(v.find("s")->string, "x\"yA\n");
+  EXPECT_EQ(v.find("o")->type, JsonValue::Type::kObject);
+  EXPECT_EQ(v.find("missing"), nullptr);
+}
+
+TEST(JsonReader, RejectsMalformedTextWithLineAndColumn) {
+  JsonValue v;
+  for (const char* bad : {"", "{", "[1,]", "{\"a\" 1}", "01x", "1.", "\"abc", "[1] 2", "{'a':1}",
+                          "-", "tru", "\"\\q\""}) {
+    const Status status = parseJson(bad, &v);
+    EXPECT_FALSE(status.ok()) << "accepted: " << bad;
+    EXPECT_NE(status.message().find("line"), std::string::npos) << status.message();
+  }
+  const Status status = parseJson("{\n  \"a\": ]\n}", &v);
+  EXPECT_NE(status.message().find("line 2 column 8"), std::string::npos) << status.message();
+}
+
+TEST(JsonReader, RefusesHostileNesting) {
+  JsonValue v;
+  EXPECT_FALSE(parseJson(std::string(100000, '['), &v).ok());
+}
+
+}  // namespace
+}  // namespace plumb::runtime
