@@ -1,0 +1,122 @@
+#include "drivers/fault/resilient_source.h"
+
+#include <algorithm>
+#include <cstdio>
+
+namespace plumb {
+namespace {
+
+const char* eventName(SourceEventKind kind) {
+  switch (kind) {
+    case SourceEventKind::kError: return "error";
+    case SourceEventKind::kStallTimeout: return "stall timeout";
+    case SourceEventKind::kReopenFailed: return "reopen failed";
+    case SourceEventKind::kReconnected: return "reconnected";
+    case SourceEventKind::kGaveUp: return "gave up";
+    case SourceEventKind::kGap: return "frames missing";
+  }
+  return "?";
+}
+
+}  // namespace
+
+ResilientSource::ResilientSource(std::unique_ptr<FrameSource> inner,
+                                 const ResilientSourceOptions& options, SourceClock& clock)
+    : inner_(std::move(inner)), options_(options), clock_(clock) {
+  last_frame_ns_ = clock_.nowNs();
+}
+
+void ResilientSource::record(SourceEventKind kind, uint64_t frames) {
+  if (!stats_.events.push_back(SourceEvent{clock_.nowNs(), kind, frames, last_sequence_}))
+    ++stats_.events_dropped;
+}
+
+SourceResult ResilientSource::next(RgbdImage& out) {
+  // Each failure gets one full round of reopen attempts; a source that fails again straight
+  // after every successful reopen is bounded by the same budget.
+  for (int round = 0; round <= std::max(options_.max_reopen_attempts, 1); ++round) {
+    const SourceResult r = inner_->next(out);
+    if (r == SourceResult::kFrame) {
+      if (have_last_sequence_ && out.sequence > last_sequence_ + 1) {
+        const uint64_t missing = out.sequence - last_sequence_ - 1;
+        stats_.frames_missing += missing;
+        ++stats_.gaps;
+        record(SourceEventKind::kGap, missing);
+      }
+      have_last_sequence_ = true;
+      last_sequence_ = out.sequence;
+      last_frame_ns_ = clock_.nowNs();
+      ++stats_.frames_delivered;
+      return r;
+    }
+    if (r == SourceResult::kEndOfStream) return r;
+    if (r == SourceResult::kNoFrame) {
+      ++stats_.no_frame_results;
+      if (options_.stall_timeout_ns <= 0 || !inner_->isLive() ||
+          clock_.nowNs() - last_frame_ns_ < options_.stall_timeout_ns)
+        return r;
+      ++stats_.stall_timeouts;
+      stats_.last_error = inner_->describe() + ": no frame for " +
+                          std::to_string((clock_.nowNs() - last_frame_ns_) / 1000000) + " ms";
+      record(SourceEventKind::kStallTimeout);
+      if (!recover()) return SourceResult::kError;
+      continue;
+    }
+    ++stats_.errors;
+    stats_.last_error = inner_->lastError().message();
+    record(SourceEventKind::kError);
+    if (!inner_->isLive() || !recover()) {
+      error_ = inner_->isLive() ? error_ : inner_->lastError();
+      return SourceResult::kError;
+    }
+  }
+  error_ = Status::Error(describe() + ": source keeps failing right after every reopen");
+  return SourceResult::kError;
+}
+
+bool ResilientSource::recover() {
+  const int64_t failed_at_ns = clock_.nowNs();
+  int64_t backoff_ns = options_.initial_backoff_ns;
+  for (int attempt = 1; options_.max_reopen_attempts == 0 || attempt <= options_.max_reopen_attempts;
+       ++attempt) {
+    ++stats_.reopen_attempts;
+    const Status st = inner_->reopen();
+    if (st.ok()) {
+      ++stats_.reconnects;
+      stats_.time_disconnected_ns += clock_.nowNs() - failed_at_ns;
+      last_frame_ns_ = clock_.nowNs();
+      record(SourceEventKind::kReconnected, static_cast<uint64_t>(attempt));
+      return true;
+    }
+    ++stats_.reopen_failures;
+    stats_.last_error = st.message();
+    record(SourceEventKind::kReopenFailed);
+    clock_.sleepForNs(backoff_ns);
+    backoff_ns = std::min<int64_t>(options_.max_backoff_ns,
+                                   static_cast<int64_t>(backoff_ns * options_.backoff_multiplier));
+  }
+  stats_.time_disconnected_ns += clock_.nowNs() - failed_at_ns;
+  record(SourceEventKind::kGaveUp);
+  error_ = Status::Error(describe() + ": gave up after " +
+                         std::to_string(options_.max_reopen_attempts) +
+                         " reopen attempts; last error: " + stats_.last_error);
+  return false;
+}
+
+std::string ResilientSource::describeEvents() const {
+  std::string text;
+  char line[160];
+  for (const SourceEvent& e : stats_.events) {
+    std::snprintf(line, sizeof line, "t=%.3fs after frame %llu: %s%s\n", e.t_ns * 1e-9,
+                  static_cast<unsigned long long>(e.last_sequence), eventName(e.kind),
+                  e.kind == SourceEventKind::kGap
+                      ? (" (" + std::to_string(e.frames) + ")").c_str()
+                      : "");
+    text += line;
+  }
+  if (stats_.events_dropped > 0)
+    text += "(" + std::to_string(stats_.events_dropped) + " later events not kept)\n";
+  return text;
+}
+
+}  // namespace plumb

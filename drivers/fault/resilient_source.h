@@ -1,0 +1,87 @@
+#pragma once
+// ResilientSource: supervises a live FrameSource. When the source fails (kError: unplugged,
+// driver error) or stalls for longer than a timeout, it records the event, reopens the source
+// with exponential backoff, and carries on; frames lost meanwhile are counted from the gaps in
+// RgbdImage::sequence. The pipeline downstream keeps its map and simply sees a sequence gap.
+//
+// next() blocks while reconnecting (sleeping through the injected clock), which is what a capture
+// thread wants; it returns kError only when max_reopen_attempts is exhausted.
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "drivers/common/frame_source.h"
+#include "drivers/fault/source_clock.h"
+#include "platform/fixed_vector.h"
+
+namespace plumb {
+
+struct ResilientSourceOptions {
+  int64_t initial_backoff_ns = 50'000'000;  // 50 ms: USB re-enumeration takes about this long
+  double backoff_multiplier = 2.0;
+  int64_t max_backoff_ns = 2'000'000'000;   // 2 s: retry often enough to catch a replug quickly
+  int max_reopen_attempts = 30;             // per failure; 0 = retry forever
+  // No frame for this long (only kNoFrame results) counts as a failure and triggers a reopen.
+  // 0 disables it. 3 s is ~100 frames at 30 Hz: far beyond any healthy USB hiccup.
+  int64_t stall_timeout_ns = 3'000'000'000;
+};
+
+enum class SourceEventKind { kError, kStallTimeout, kReopenFailed, kReconnected, kGaveUp, kGap };
+
+struct SourceEvent {
+  int64_t t_ns = 0;           // clock time of the event
+  SourceEventKind kind = SourceEventKind::kError;
+  uint64_t frames = 0;        // kGap: frames missing; kReconnected: attempts it took
+  uint64_t last_sequence = 0; // the last frame delivered before the event
+};
+
+struct ResilienceStats {
+  uint64_t frames_delivered = 0;
+  uint64_t frames_missing = 0;    // sum of sequence gaps
+  uint64_t gaps = 0;              // number of gaps
+  uint64_t no_frame_results = 0;  // kNoFrame passed through (timeouts)
+  uint64_t errors = 0;            // kError results seen from the source
+  uint64_t stall_timeouts = 0;
+  uint64_t reopen_attempts = 0;
+  uint64_t reopen_failures = 0;
+  uint64_t reconnects = 0;
+  int64_t time_disconnected_ns = 0;  // summed from failure to successful reopen
+  // The first kMaxEvents events (bounded: a flapping sensor must not grow memory).
+  static constexpr std::size_t kMaxEvents = 64;
+  FixedVector<SourceEvent, kMaxEvents> events;
+  uint64_t events_dropped = 0;
+  std::string last_error;
+};
+
+class ResilientSource : public FrameSource {
+ public:
+  ResilientSource(std::unique_ptr<FrameSource> inner, const ResilientSourceOptions& options,
+                  SourceClock& clock = steadyClock());
+
+  SourceResult next(RgbdImage& out) override;
+  const PinholeCamera& camera() const override { return inner_->camera(); }
+  std::string describe() const override { return "resilient(" + inner_->describe() + ")"; }
+  const Status& lastError() const override { return error_; }
+  Status reopen() override { return inner_->reopen(); }
+  bool isLive() const override { return inner_->isLive(); }
+
+  const ResilienceStats& stats() const { return stats_; }
+  // One line per event ("t=1.250s error: ..."), for run reports.
+  std::string describeEvents() const;
+
+ private:
+  // Reopens with backoff; true when the source is back.
+  bool recover();
+  void record(SourceEventKind kind, uint64_t frames = 0);
+
+  std::unique_ptr<FrameSource> inner_;
+  ResilientSourceOptions options_;
+  SourceClock& clock_;
+  ResilienceStats stats_;
+  Status error_;
+  bool have_last_sequence_ = false;
+  uint64_t last_sequence_ = 0;
+  int64_t last_frame_ns_ = 0;
+};
+
+}  // namespace plumb
