@@ -39,6 +39,8 @@ Status readTextLines(const std::string& path, std::vector<TextLine>* out) {
     TextLine line;
     line.number = number;
     line.is_comment = text[first] == '#';
+    // A `#` after the data starts a trailing comment (`fx 517.3  # Freiburg 1`).
+    if (!line.is_comment) text = text.substr(0, text.find('#'));
     splitTokens(text, line.is_comment ? first + 1 : first, &line.tokens);
     out->push_back(std::move(line));
   }

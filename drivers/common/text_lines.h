@@ -1,7 +1,8 @@
 #pragma once
 // Line-oriented text files (image lists, trajectories, camera files): every non-blank line split
 // into tokens, with its 1-based line number so parse errors can say `file:line: what`.
-// Separators are spaces, tabs and commas (the TUM scripts accept all three).
+// Separators are spaces, tabs and commas (the TUM scripts accept all three). `#` starts a
+// comment: a whole-line comment is kept (its tokens), a trailing one is dropped.
 #include <string>
 #include <vector>
 

@@ -1,5 +1,7 @@
 #include "drivers/dataset/camera_presets.h"
 
+#include <fstream>
+
 #include "drivers/dataset/camera_file.h"
 
 namespace plumb {
@@ -56,6 +58,9 @@ Status cameraFromSpec(const std::string& preset_or_file, PinholeCamera* out) {
   if (isCameraPresetName(preset_or_file)) {
     PLUMB_RETURN_IF_ERROR(cameraPreset(preset_or_file, &camera));
   } else {
+    if (!std::ifstream(preset_or_file).good())
+      return Status::Error("camera '" + preset_or_file +
+                           "' is neither a preset (tum1 tum2 tum3 icl) nor a readable camera file");
     PLUMB_RETURN_IF_ERROR(readCameraFile(preset_or_file, &camera));
   }
   const std::string problem = camera.validate();

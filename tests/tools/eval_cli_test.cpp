@@ -1,0 +1,131 @@
+// `plumb eval` from the command line: the published answers, JSON output, the plot, and bad input
+// (non-zero exit and a message naming the file).
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <gtest/gtest.h>
+
+namespace {
+
+const std::string kPlumb = PLUMB_BINARY_DIR "/bin/plumb";
+const std::string kReference = PLUMB_DATASETS_DIR "/reference_trajectories";
+
+struct RunResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+RunResult runPlumb(const std::string& arguments) {
+  RunResult result;
+  const std::string command = "'" + kPlumb + "' " + arguments + " 2>&1";
+  std::FILE* pipe = ::popen(command.c_str(), "r");
+  if (!pipe) return result;
+  char buffer[4096];
+  std::size_t n;
+  while ((n = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0) result.output.append(buffer, n);
+  const int status = ::pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+// A private folder per test (ctest runs tests as parallel processes).
+class ScratchDir {
+ public:
+  ScratchDir() {
+    std::string pattern = (std::filesystem::temp_directory_path() / "plumb_eval_XXXXXX").string();
+    if (::mkdtemp(pattern.data())) path_ = pattern;
+  }
+  ~ScratchDir() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  std::string write(const std::string& name, const std::string& content) const {
+    std::ofstream(path_ + "/" + name, std::ios::binary) << content;
+    return path_ + "/" + name;
+  }
+  std::string file(const std::string& name) const { return path_ + "/" + name; }
+
+ private:
+  std::string path_;
+};
+
+bool haveReferenceTrajectories() { return std::filesystem::is_directory(kReference); }
+
+TEST(EvalCli, Freiburg1XyzGivesThePublishedAte) {
+  if (!haveReferenceTrajectories()) GTEST_SKIP() << kReference << " not found: skipping";
+  const RunResult r = runPlumb("eval --gt " + kReference + "/freiburg1_xyz-groundtruth.txt --est " +
+                               kReference + "/freiburg1_xyz-rgbdslam.txt");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("ATE RMSE 0.0135 m over 786 pairs"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("RPE translation RMSE"), std::string::npos) << r.output;
+}
+
+TEST(EvalCli, Freiburg2DeskJsonAndPlot) {
+  if (!haveReferenceTrajectories()) GTEST_SKIP() << kReference << " not found: skipping";
+  ScratchDir dir;
+  const std::string plot = dir.file("plot.png");
+  const RunResult r = runPlumb("eval --json --gt " + kReference + "/fr2_desk_groundtruth.txt --est " +
+                               kReference + "/fr2_desk_ORB.txt --plot " + plot);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::size_t rmse_at = r.output.find("\"rmse_m\": ");
+  ASSERT_NE(rmse_at, std::string::npos) << r.output;
+  const double rmse = std::strtod(r.output.c_str() + rmse_at + 10, nullptr);
+  EXPECT_NEAR(rmse, 0.0081, 0.0001);
+  EXPECT_NE(r.output.find("\"pairs\": 2223"), std::string::npos) << r.output;
+  // The ground truth has one duplicated stamp; the tool says what it did with it.
+  EXPECT_NE(r.output.find("duplicate timestamp"), std::string::npos) << r.output;
+  const cv::Mat image = cv::imread(plot, cv::IMREAD_COLOR);
+  ASSERT_FALSE(image.empty()) << "no plot written to " << plot;
+  EXPECT_GE(image.cols, 300);
+  // Not a blank canvas: the drawing put both trajectory colours on it.
+  cv::Mat not_white;
+  cv::inRange(image, cv::Scalar(0, 0, 0), cv::Scalar(250, 250, 250), not_white);
+  EXPECT_GT(cv::countNonZero(not_white), image.total() / 100);
+}
+
+TEST(EvalCli, MissingFileExitsNonZeroNamingIt) {
+  ScratchDir dir;
+  const std::string gt = dir.write("gt.txt", "1.0 0 0 0 0 0 0 1\n");
+  const RunResult r = runPlumb("eval --gt " + gt + " --est " + dir.file("missing_est.txt"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find(dir.file("missing_est.txt")), std::string::npos) << r.output;
+}
+
+TEST(EvalCli, CorruptFileExitsNonZeroNamingFileAndLine) {
+  ScratchDir dir;
+  const std::string gt = dir.write("gt.txt", "1.0 0 0 0 0 0 0 1\n2.0 0 0 0 0 0 0 1\n3.0 0 0 0 0 0 0 1\n");
+  const std::string est = dir.write("est.txt", "1.0 0 0 0 0 0 0 1\n2.0 0 0 0 0 0 0 1\n3.0 0 0 nan 0 0 0 1\n");
+  RunResult r = runPlumb("eval --gt " + gt + " --est " + est);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find(est + ":3"), std::string::npos) << r.output;
+
+  const std::string binary = dir.write("binary.txt", std::string("\x89PNG\r\n\x1a\n\0\0\0", 11));
+  r = runPlumb("eval --gt " + binary + " --est " + gt);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find(binary), std::string::npos) << r.output;
+}
+
+TEST(EvalCli, UnrelatedTrajectoriesAreAnErrorNotANumber) {
+  ScratchDir dir;
+  const std::string gt = dir.write("gt.txt", "1.0 0 0 0 0 0 0 1\n2.0 1 0 0 0 0 0 1\n3.0 2 0 0 0 0 0 1\n");
+  const std::string est = dir.write("est.txt", "71.0 0 0 0 0 0 0 1\n72.0 1 0 0 0 0 0 1\n73.0 2 0 0 0 0 0 1\n");
+  const RunResult r = runPlumb("eval --gt " + gt + " --est " + est);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_EQ(r.output.find("ATE RMSE"), std::string::npos) << r.output;
+}
+
+TEST(EvalCli, UsageErrorsExitWithTwo) {
+  EXPECT_EQ(runPlumb("eval").exit_code, 2);
+  EXPECT_EQ(runPlumb("eval --gt a.txt").exit_code, 2);
+  EXPECT_EQ(runPlumb("eval --gt a.txt --est b.txt --bogus").exit_code, 2);
+  EXPECT_EQ(runPlumb("eval --help").exit_code, 0);
+}
+
+}  // namespace
