@@ -43,13 +43,16 @@ struct ExtractorOptions {
   NoiseModelOptions noise;
 };
 
-// Wall-clock cost of the last extract() call, milliseconds (steady clock).
+// Cost of the last extract() call in milliseconds: wall clock (steady clock) and, in the *_cpu_ms
+// fields, this thread's CPU time (CLOCK_THREAD_CPUTIME_ID), which does not count time the thread
+// waited for a core -- the honest number on a loaded machine.
 struct ExtractorTimings {
   double pyramid_ms = 0;   // grey conversion + pyramid + descriptor blur
   double orb_ms = 0;       // FAST, spreading, orientation, rBRIEF (includes pyramid_ms)
   double lines_ms = 0;     // LSD + ranking + LBD-style descriptors
   double depth_ms = 0;     // keypoint depth/noise + line samples + robust 3D fits
   double total_ms = 0;
+  double orb_cpu_ms = 0, lines_cpu_ms = 0, depth_cpu_ms = 0, total_cpu_ms = 0;
   int num_keypoints = 0;
   int num_keypoints_with_depth = 0;
   int num_lines = 0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 
 #include <opencv2/imgproc.hpp>
 
@@ -14,6 +15,12 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+double threadCpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
 
 // Undistorted-pixel bounds of the whole raw image (barrel distortion pushes them outside
 // [0,w)x[0,h)), found by undistorting points along the border.
@@ -53,6 +60,7 @@ FeatureExtractor::~FeatureExtractor() = default;
 
 bool FeatureExtractor::extract(const RgbdImage& in, FrameFeatures& out) {
   const auto t_start = Clock::now();
+  const double cpu_start = threadCpuMs();
   out.clear();
   timings_ = ExtractorTimings();
   if (in.bgr.empty() || in.bgr.cols != camera_.width || in.bgr.rows != camera_.height ||
@@ -66,26 +74,33 @@ bool FeatureExtractor::extract(const RgbdImage& in, FrameFeatures& out) {
   }
 
   const auto t_orb = Clock::now();
+  const double cpu_orb = threadCpuMs();
   orb_->extract(grey_, out);
   timings_.orb_ms = msSince(t_orb);
+  timings_.orb_cpu_ms = threadCpuMs() - cpu_orb;
   timings_.pyramid_ms = orb_->lastPyramidMs();
 
   const auto t_lines = Clock::now();
+  const double cpu_lines = threadCpuMs();
   lines_->extract(orb_->pyramid(), out);
   timings_.lines_ms = msSince(t_lines);
+  timings_.lines_cpu_ms = threadCpuMs() - cpu_lines;
   timings_.lsd_raw_segments = lines_->lastRawSegments();
 
   const auto t_depth = Clock::now();
+  const double cpu_depth = threadCpuMs();
   const bool depth_ok = !in.depth_raw.empty() && in.depth_raw.type() == CV_16UC1 &&
                         in.depth_raw.cols == camera_.width && in.depth_raw.rows == camera_.height;
   depth_->attachDepth(depth_ok ? in.depth_raw : cv::Mat(), in.depth_factor, out);
   timings_.depth_ms = msSince(t_depth);
+  timings_.depth_cpu_ms = threadCpuMs() - cpu_depth;
 
   out.keypoint_grid.setBounds(grid_u0_, grid_v0_, grid_u1_, grid_v1_);
   out.keypoint_grid.build(static_cast<int>(out.keypoints.size()),
                           [&out](int i) { return out.keypoints[i].px_undist; });
 
   timings_.total_ms = msSince(t_start);
+  timings_.total_cpu_ms = threadCpuMs() - cpu_start;
   timings_.num_keypoints = static_cast<int>(out.keypoints.size());
   timings_.num_lines = static_cast<int>(out.lines.size());
   for (const KeypointObservation& kp : out.keypoints) timings_.num_keypoints_with_depth += kp.depth_m > 0;

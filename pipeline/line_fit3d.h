@@ -10,6 +10,7 @@
 #include <cstdint>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "pipeline/capacities.h"
 

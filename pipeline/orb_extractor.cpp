@@ -7,7 +7,6 @@
 namespace plumb {
 namespace {
 
-constexpr int kRejected = 1 << 30;
 // FAST corners kept per level after suppression; a 640x480 level rarely exceeds ~15k at
 // threshold 7, and a full buffer only drops corners at the bottom of the image.
 constexpr int kMaxCornersPerLevel = 40000;
@@ -20,6 +19,7 @@ OrbExtractor::OrbExtractor(const PinholeCamera& camera, const ExtractorOptions& 
       fast_(camera.width, camera.height, kMaxCornersPerLevel),
       describer_(pyramid_.stride()) {
   ranked_.resize(kMaxCornersPerLevel);
+  cell_has_corner_.resize(static_cast<size_t>(camera.width / 8 + 1) * (camera.height / 8 + 1));
   // Geometric share per level: n0 * (1/s)^i, summing to num_features (ORB-SLAM's split).
   const int levels = pyramid_.numLevels();
   const double inv = 1.0 / options.scale_factor;
@@ -50,9 +50,27 @@ void OrbExtractor::extract(const cv::Mat& grey, FrameFeatures& out) {
 void OrbExtractor::selectOnLevel(int level, int wanted, FrameFeatures& out) {
   const cv::Mat& image = pyramid_.level(level);
   const int border = OrbDescriber::kBorder;
-  const int num = fast_.detect(image, options_.fast_threshold_low, border);
   const int cell = std::max(8, options_.cell_size_px);
   const int cols = std::max(1, (image.cols - 2 * border + cell - 1) / cell);
+  const int rows = std::max(1, (image.rows - 2 * border + cell - 1) / cell);
+  // Adaptive threshold (ORB-SLAM): the whole level at the high threshold, then only the cells
+  // that found nothing again at the low one. Scanning everything at the low threshold would
+  // score ~10x more corners on noisy Kinect images.
+  fast_.begin(image, border);
+  fast_.scan(options_.fast_threshold_high, 0, 0, image.cols, image.rows);
+  std::fill_n(cell_has_corner_.begin(), cols * rows, false);
+  for (int i = 0; i < fast_.numRaw(); ++i) {
+    const FastCorner& c = fast_.rawCorners()[i];
+    cell_has_corner_[((c.y - border) / cell) * cols + (c.x - border) / cell] = true;
+  }
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      if (cell_has_corner_[r * cols + c]) continue;
+      const int x0 = border + c * cell, y0 = border + r * cell;
+      fast_.scan(options_.fast_threshold_low, x0, y0, x0 + cell, y0 + cell);
+    }
+  }
+  const int num = fast_.suppress();
 
   const FastCorner* corners = fast_.corners();
   for (int i = 0; i < num; ++i) {
@@ -67,12 +85,9 @@ void OrbExtractor::selectOnLevel(int level, int wanted, FrameFeatures& out) {
   std::sort(begin, end, [&](const RankedCorner& a, const RankedCorner& b) {
     return a.cell != b.cell ? a.cell < b.cell : stronger(a.corner, b.corner);
   });
-  const int high = options_.fast_threshold_high;
   for (int i = 0, cell_first = 0; i < num; ++i) {
     if (i == 0 || ranked_[i].cell != ranked_[i - 1].cell) cell_first = i;
-    const bool cell_has_strong = ranked_[cell_first].corner.score > high;
-    const bool weak = ranked_[i].corner.score <= high;
-    ranked_[i].rank = (cell_has_strong && weak) ? kRejected : i - cell_first;
+    ranked_[i].rank = i - cell_first;
   }
   const int take = std::min(wanted, num);
   std::partial_sort(begin, begin + take, end, [&](const RankedCorner& a, const RankedCorner& b) {
@@ -84,7 +99,6 @@ void OrbExtractor::selectOnLevel(int level, int wanted, FrameFeatures& out) {
   const uint8_t* blurred_origin = pyramid_.blurred(level).ptr<uint8_t>(0);
   const int stride = pyramid_.stride();
   for (int i = 0; i < take; ++i) {
-    if (ranked_[i].rank == kRejected) break;
     const FastCorner& c = ranked_[i].corner;
     KeypointObservation* kp = out.keypoints.emplace_back();
     Descriptor256* descriptor = out.keypoint_descriptors.emplace_back();

@@ -1,12 +1,12 @@
 #pragma once
 // OrbExtractor: ORB keypoints spread over the image, written into FrameFeatures.
 //
-// Per pyramid level: FAST-9 at the low threshold with 3x3 suppression; the level's share of
+// Per pyramid level: FAST-9 with 3x3 suppression; the level's share of
 // num_features (geometric in the scale, as ORB-SLAM) is filled round-robin over grid cells
 // (every cell's best corner first, then every cell's second best, ...), each round strongest
-// first. A cell that has corners above the high threshold uses only those; a cell that has none
-// falls back to the low threshold, so weak-texture regions still get keypoints (ORB-SLAM's
-// adaptive FAST threshold, without running FAST twice). Then orientation by intensity centroid,
+// first. FAST runs on the whole level at the high threshold, and again at the low threshold in
+// the cells that found nothing, so weak-texture regions still get keypoints (ORB-SLAM's
+// adaptive threshold). Then orientation by intensity centroid,
 // rotated BRIEF on the blurred level, and undistortion of the keypoint coordinate.
 #include <vector>
 
@@ -35,7 +35,7 @@ class OrbExtractor {
   struct RankedCorner {
     FastCorner corner;
     int cell = 0;
-    int rank = 0;  // position within its cell, strongest first; kRejected when below the cell's bar
+    int rank = 0;  // position within its cell, strongest first
   };
 
   void selectOnLevel(int level, int wanted, FrameFeatures& out);
@@ -47,6 +47,7 @@ class OrbExtractor {
   OrbDescriber describer_;
   std::array<int, kPyramidLevels> features_per_level_{};
   std::vector<RankedCorner> ranked_;  // capacity fixed in the constructor, never grows
+  std::vector<char> cell_has_corner_;  // per spreading cell of the current level (sized for 8 px cells)
   double pyramid_ms_ = 0;
 };
 

@@ -20,11 +20,18 @@ class FastDetector {
   // max_width/max_height: the largest image it will see (level 0); capacity: corners kept.
   FastDetector(int max_width, int max_height, int capacity);
 
-  // Corners with score > threshold, at least `border` px from the image edge, that are 3x3
-  // local maxima of the score (ties broken by raster order). Returns the count written to
-  // corners(); `dropped()` counts corners lost to a full buffer (0 in practice).
-  int detect(const cv::Mat& image, int threshold, int border);
+  // Detection in three steps so a caller can scan regions with different thresholds (ORB's
+  // adaptive threshold): begin() clears the score map of `image`, scan() adds corners with
+  // score > threshold inside [x0,x1)x[y0,y1) (clipped to `border` from the image edge; regions
+  // must not overlap), suppress() keeps the 3x3 local maxima of the score (ties broken by raster
+  // order) and returns their count, written to corners().
+  void begin(const cv::Mat& image, int border);
+  void scan(int threshold, int x0, int y0, int x1, int y1);
+  int suppress();
 
+  // Raw (unsuppressed) corners found so far, e.g. to see which regions are still empty.
+  int numRaw() const { return num_raw_; }
+  const FastCorner* rawCorners() const { return raw_; }
   const FastCorner* corners() const { return kept_; }
   int dropped() const { return dropped_; }
 
@@ -35,6 +42,9 @@ class FastDetector {
   FastCorner* kept_;    // after suppression
   std::unique_ptr<FastCorner[]> storage_;
   int dropped_ = 0;
+  int num_raw_ = 0;
+  cv::Mat image_;  // header of the image being scanned (no copy)
+  int border_ = 3;
 };
 
 // Score of pixel `p` (pointer into an image with row stride `stride`): max over the 16 arcs of 9

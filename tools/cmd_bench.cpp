@@ -1,0 +1,178 @@
+// plumb bench frontend: per-frame cost of the measurement front end (ORB, lines + LBD, depth +
+// line-guidance sampling) on a TUM-layout sequence, single thread, next to the stock OpenCV path
+// (cv::ORB 1000/8/1.2 + line_descriptor::LSDDetector + BinaryDescriptor) on the same frames.
+// Prints median / p99 per stage; the last two lines are the machine-readable summary:
+//   frontend_ms_median X
+//   stock_opencv_ms_median Y
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/line_descriptor.hpp>
+
+#include "drivers/dataset/camera_presets.h"
+#include "drivers/dataset/tum_dataset.h"
+#include "pipeline/feature_extractor.h"
+#include "tools/args.h"
+#include "tools/command.h"
+
+namespace plumb::tools {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+double threadCpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+struct Series {
+  const char* name;
+  std::vector<double> ms;
+  double percentile(double p) const {
+    if (ms.empty()) return 0;
+    std::vector<double> s = ms;
+    std::sort(s.begin(), s.end());
+    const size_t i = std::min(s.size() - 1, static_cast<size_t>(p * (s.size() - 1) + 0.5));
+    return s[i];
+  }
+  void print() const { std::printf("  %-24s median %7.2f ms   p99 %7.2f ms\n", name, percentile(0.5), percentile(0.99)); }
+};
+
+void printUsage() {
+  std::printf(
+      "usage: plumb bench frontend --dataset DIR [--camera tum1] [--frames N] [--no-stock]\n"
+      "  Runs the front end (pipeline/feature_extractor.h) with default ExtractorOptions on every\n"
+      "  frame of a TUM-layout folder, single thread, then the stock OpenCV path on the same frame.\n");
+}
+
+// The stock path the issue compares against: cv::ORB 1000 features, 8 levels, 1.2, and the contrib
+// LSDDetector + BinaryDescriptor (LBD) on every detected line.
+struct StockPath {
+  cv::Ptr<cv::ORB> orb = cv::ORB::create(1000, 1.2f, 8);
+  cv::Ptr<cv::line_descriptor::LSDDetector> lsd = cv::line_descriptor::LSDDetector::createLSDDetector();
+  cv::Ptr<cv::line_descriptor::BinaryDescriptor> lbd = cv::line_descriptor::BinaryDescriptor::createBinaryDescriptor();
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors, line_descriptors, grey;
+  std::vector<cv::line_descriptor::KeyLine> keylines;
+  double orb_ms = 0, lsd_ms = 0, lbd_ms = 0;
+
+  void run(const cv::Mat& bgr) {
+    cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+    auto t = Clock::now();
+    orb->detectAndCompute(grey, cv::noArray(), keypoints, descriptors);
+    orb_ms = msSince(t);
+    t = Clock::now();
+    keylines.clear();
+    lsd->detect(grey, keylines, 2, 1);
+    lsd_ms = msSince(t);
+    t = Clock::now();
+    lbd->compute(grey, keylines, line_descriptors);
+    lbd_ms = msSince(t);
+  }
+};
+
+int benchFrontend(int argc, char** argv) {
+  Args args(argc, argv, {"dataset", "camera", "frames"}, {"no-stock"});
+  if (args.help()) { printUsage(); return 0; }
+  if (!args.error().empty() || !args.has("dataset")) {
+    std::fprintf(stderr, "plumb bench frontend: %s\n", args.error().empty() ? "--dataset is required" : args.error().c_str());
+    printUsage();
+    return 2;
+  }
+  bool ok = true;
+  const long max_frames = args.getInt("frames", -1, &ok);
+  if (!ok) { std::fprintf(stderr, "plumb bench frontend: --frames needs an integer\n"); return 2; }
+  PinholeCamera camera;
+  Status st = cameraFromSpec(args.get("camera", "tum1"), &camera);
+  std::unique_ptr<TumDatasetSource> source;
+  if (st.ok()) st = TumDatasetSource::open(args.get("dataset"), camera, &source);
+  if (!st.ok()) { std::fprintf(stderr, "plumb bench frontend: %s\n", st.message().c_str()); return 1; }
+
+  cv::setNumThreads(1);  // single thread, for both paths
+  const ExtractorOptions options;
+  FeatureExtractor extractor(camera, options);
+  auto features = std::make_unique<FrameFeatures>();
+  StockPath stock;
+  const bool run_stock = !args.has("no-stock");
+
+  Series orb{"ORB", {}}, lines{"lines + LBD", {}}, depth{"depth + sampling", {}}, total{"frontend total", {}};
+  Series cpu_total{"frontend total (CPU)", {}}, s_cpu_total{"stock total (CPU)", {}};
+  Series s_orb{"stock cv::ORB", {}}, s_lsd{"stock LSDDetector", {}}, s_lbd{"stock BinaryDescriptor", {}},
+      s_total{"stock total", {}};
+  double sum_kp = 0, sum_kp_depth = 0, sum_lines = 0, sum_lines3d = 0, sum_stock_lines = 0;
+  RgbdImage frame;
+  const size_t n = max_frames > 0 ? std::min<size_t>(source->size(), max_frames) : source->size();
+  for (size_t i = 0; i < n; ++i) {
+    st = source->load(i, frame);
+    if (!st.ok()) { std::fprintf(stderr, "plumb bench frontend: %s\n", st.message().c_str()); return 1; }
+    if (!extractor.extract(frame, *features)) {
+      std::fprintf(stderr, "plumb bench frontend: frame %zu does not match the camera size\n", i);
+      return 1;
+    }
+    const ExtractorTimings& t = extractor.lastTimings();
+    orb.ms.push_back(t.orb_ms);
+    lines.ms.push_back(t.lines_ms);
+    depth.ms.push_back(t.depth_ms);
+    total.ms.push_back(t.total_ms);
+    cpu_total.ms.push_back(t.total_cpu_ms);
+    sum_kp += t.num_keypoints;
+    sum_kp_depth += t.num_keypoints_with_depth;
+    sum_lines += t.num_lines;
+    sum_lines3d += t.num_lines_3d;
+    if (run_stock) {
+      const auto t0 = Clock::now();
+      const double cpu0 = threadCpuMs();
+      stock.run(frame.bgr);
+      s_total.ms.push_back(msSince(t0));
+      s_cpu_total.ms.push_back(threadCpuMs() - cpu0);
+      s_orb.ms.push_back(stock.orb_ms);
+      s_lsd.ms.push_back(stock.lsd_ms);
+      s_lbd.ms.push_back(stock.lbd_ms);
+      sum_stock_lines += stock.keylines.size();
+    }
+  }
+  const double frames = std::max<size_t>(n, 1);
+  std::printf("plumb bench frontend: %zu frames of %s, 1 thread\n", n, args.get("dataset").c_str());
+  std::printf("  per frame: %.0f keypoints (%.0f with depth), %.0f lines (%.0f with a 3D fit, %d samples max)\n",
+              sum_kp / frames, sum_kp_depth / frames, sum_lines / frames, sum_lines3d / frames, options.line_samples);
+  orb.print();
+  lines.print();
+  depth.print();
+  total.print();
+  cpu_total.print();
+  if (run_stock) {
+    std::printf("  stock path: %.0f lines described per frame\n", sum_stock_lines / frames);
+    s_orb.print();
+    s_lsd.print();
+    s_lbd.print();
+    s_total.print();
+    s_cpu_total.print();
+    std::printf("  speed-up (stock / frontend, medians): wall %.1fx, CPU %.1fx\n",
+                s_total.percentile(0.5) / total.percentile(0.5), s_cpu_total.percentile(0.5) / cpu_total.percentile(0.5));
+    std::printf("  (wall = steady clock; CPU = this thread's CPU time, which excludes waiting for a core)\n");
+  }
+  std::printf("frontend_ms_median %.2f\n", total.percentile(0.5));
+  if (run_stock) std::printf("stock_opencv_ms_median %.2f\n", s_total.percentile(0.5));
+  return 0;
+}
+
+int benchMain(int argc, char** argv) {
+  if (argc >= 1 && std::string(argv[0]) == "frontend") return benchFrontend(argc - 1, argv + 1);
+  std::fprintf(stderr, "usage: plumb bench frontend --dataset DIR   (the only benchmark so far)\n");
+  return argc >= 1 && (std::string(argv[0]) == "--help" || std::string(argv[0]) == "-h") ? 0 : 2;
+}
+
+}  // namespace
+
+PLUMB_COMMAND(bench, "benchmarks: `plumb bench frontend --dataset DIR` (front end vs stock OpenCV)", benchMain);
+
+}  // namespace plumb::tools
