@@ -81,7 +81,7 @@ void drawAxes(cv::Mat& image, const Panel& p, const std::string& x_label, const 
   }
   cv::rectangle(image, p.area, kBlack, 1);
   putText(image, x_label, {p.area.x + p.area.width / 2 - 30, p.area.y + p.area.height + 38}, 0.5);
-  putText(image, y_label, {p.area.x - 60, p.area.y - 10}, 0.5);
+  putText(image, y_label, {p.area.x, p.area.y - 8}, 0.5);
 }
 
 // Draws the curve through `points` (one per ATE sample), broken where the samples are more
