@@ -1,0 +1,237 @@
+#include "drivers/v4l2/v4l2_capture.h"
+
+#include <fcntl.h>
+#include <linux/videodev2.h>
+#include <sys/mman.h>
+
+#include <cerrno>
+#include <cstring>
+#include <ctime>
+
+namespace plumb {
+namespace {
+
+uint32_t fourcc(V4l2PixelFormat format) {
+  switch (format) {
+    case V4l2PixelFormat::kYuyv: return V4L2_PIX_FMT_YUYV;
+    case V4l2PixelFormat::kMjpeg: return V4L2_PIX_FMT_MJPEG;
+    case V4l2PixelFormat::kGrey: return V4L2_PIX_FMT_GREY;
+    case V4l2PixelFormat::kZ16: return V4L2_PIX_FMT_Z16;
+  }
+  return 0;
+}
+
+std::string fourccText(uint32_t code) {
+  std::string s(4, ' ');
+  for (int i = 0; i < 4; ++i) s[i] = static_cast<char>((code >> (8 * i)) & 0xFF);
+  return s;
+}
+
+}  // namespace
+
+const char* pixelFormatName(V4l2PixelFormat format) {
+  switch (format) {
+    case V4l2PixelFormat::kYuyv: return "yuyv";
+    case V4l2PixelFormat::kMjpeg: return "mjpeg";
+    case V4l2PixelFormat::kGrey: return "grey";
+    case V4l2PixelFormat::kZ16: return "z16";
+  }
+  return "?";
+}
+
+bool parsePixelFormat(const std::string& name, V4l2PixelFormat* format) {
+  for (V4l2PixelFormat f : {V4l2PixelFormat::kYuyv, V4l2PixelFormat::kMjpeg,
+                            V4l2PixelFormat::kGrey, V4l2PixelFormat::kZ16}) {
+    if (name == pixelFormatName(f)) {
+      *format = f;
+      return true;
+    }
+  }
+  return false;
+}
+
+Status V4l2Capture::fail(const char* what, int error_number) const {
+  std::string message = options_.device_path + ": " + what + " failed: " + std::strerror(error_number);
+  if (error_number == ENODEV || error_number == ENXIO) message += " (device disconnected)";
+  return Status::Error(message);
+}
+
+Status V4l2Capture::open(const V4l2CaptureOptions& options) {
+  close();
+  options_ = options;
+  if (options.buffer_count < 2 || options.buffer_count > kMaxBuffers)
+    return Status::Error(options.device_path + ": buffer_count must be 2.." +
+                         std::to_string(kMaxBuffers));
+  fd_ = device_.open(options.device_path.c_str(), O_RDWR | O_NONBLOCK);
+  if (fd_ < 0) return fail("open", errno);
+
+  v4l2_capability cap{};
+  if (device_.ioctl(fd_, VIDIOC_QUERYCAP, &cap) < 0) {
+    const Status st = fail("VIDIOC_QUERYCAP", errno);
+    close();
+    return st;
+  }
+  const uint32_t caps = (cap.capabilities & V4L2_CAP_DEVICE_CAPS) ? cap.device_caps : cap.capabilities;
+  if (!(caps & V4L2_CAP_VIDEO_CAPTURE) || !(caps & V4L2_CAP_STREAMING)) {
+    close();
+    return Status::Error(options.device_path +
+                         ": not a streaming video capture node (VIDIOC_QUERYCAP capabilities)");
+  }
+
+  v4l2_format fmt{};
+  fmt.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+  fmt.fmt.pix.width = static_cast<uint32_t>(options.width);
+  fmt.fmt.pix.height = static_cast<uint32_t>(options.height);
+  fmt.fmt.pix.pixelformat = fourcc(options.format);
+  fmt.fmt.pix.field = V4L2_FIELD_NONE;
+  if (device_.ioctl(fd_, VIDIOC_S_FMT, &fmt) < 0) {
+    const Status st = fail("VIDIOC_S_FMT", errno);
+    close();
+    return st;
+  }
+  // Drivers adjust what they cannot do instead of failing: check what we actually got.
+  if (fmt.fmt.pix.pixelformat != fourcc(options.format) ||
+      fmt.fmt.pix.width != static_cast<uint32_t>(options.width) ||
+      fmt.fmt.pix.height != static_cast<uint32_t>(options.height)) {
+    const std::string got = fourccText(fmt.fmt.pix.pixelformat) + " " +
+                            std::to_string(fmt.fmt.pix.width) + "x" +
+                            std::to_string(fmt.fmt.pix.height);
+    close();
+    return Status::Error(options.device_path + ": VIDIOC_S_FMT: asked for " +
+                         pixelFormatName(options.format) + " " + std::to_string(options.width) +
+                         "x" + std::to_string(options.height) + ", driver offers " + got);
+  }
+  const std::size_t bytes_per_pixel =
+      options.format == V4l2PixelFormat::kGrey ? 1 : (options.format == V4l2PixelFormat::kMjpeg ? 0 : 2);
+  stride_ = fmt.fmt.pix.bytesperline ? fmt.fmt.pix.bytesperline : options.width * bytes_per_pixel;
+
+  v4l2_streamparm parm{};  // frame rate: best effort, many drivers ignore or round it
+  parm.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+  parm.parm.capture.timeperframe.numerator = 1;
+  parm.parm.capture.timeperframe.denominator = static_cast<uint32_t>(options.fps);
+  (void)device_.ioctl(fd_, VIDIOC_S_PARM, &parm);
+
+  v4l2_requestbuffers req{};
+  req.count = static_cast<uint32_t>(options.buffer_count);
+  req.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+  req.memory = V4L2_MEMORY_MMAP;
+  if (device_.ioctl(fd_, VIDIOC_REQBUFS, &req) < 0) {
+    const Status st = fail("VIDIOC_REQBUFS", errno);
+    close();
+    return st;
+  }
+  if (req.count < 2 || req.count > static_cast<uint32_t>(kMaxBuffers)) {
+    close();
+    return Status::Error(options.device_path + ": VIDIOC_REQBUFS granted " +
+                         std::to_string(req.count) + " buffers (need 2.." +
+                         std::to_string(kMaxBuffers) + ")");
+  }
+  for (uint32_t i = 0; i < req.count; ++i) {
+    v4l2_buffer buf{};
+    buf.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+    buf.memory = V4L2_MEMORY_MMAP;
+    buf.index = i;
+    if (device_.ioctl(fd_, VIDIOC_QUERYBUF, &buf) < 0) {
+      const Status st = fail("VIDIOC_QUERYBUF", errno);
+      close();
+      return st;
+    }
+    void* address = device_.mmap(buf.length, fd_, static_cast<off_t>(buf.m.offset));
+    if (address == MAP_FAILED) {
+      const Status st = fail("mmap", errno);
+      close();
+      return st;
+    }
+    (void)buffers_.push_back(MappedBuffer{address, buf.length});  // count <= kMaxBuffers
+  }
+  for (uint32_t i = 0; i < buffers_.size(); ++i) {
+    const Status st = queueBuffer(i);
+    if (!st.ok()) {
+      close();
+      return st;
+    }
+  }
+  v4l2_buf_type type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+  if (device_.ioctl(fd_, VIDIOC_STREAMON, &type) < 0) {
+    const Status st = fail("VIDIOC_STREAMON", errno);
+    close();
+    return st;
+  }
+  streaming_ = true;
+  return Status::Ok();
+}
+
+Status V4l2Capture::queueBuffer(uint32_t index) {
+  v4l2_buffer buf{};
+  buf.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+  buf.memory = V4L2_MEMORY_MMAP;
+  buf.index = index;
+  if (device_.ioctl(fd_, VIDIOC_QBUF, &buf) < 0) return fail("VIDIOC_QBUF", errno);
+  return Status::Ok();
+}
+
+SourceResult V4l2Capture::dequeue(V4l2FrameView* view, Status* error) {
+  if (fd_ < 0 || !streaming_) {
+    *error = Status::Error(options_.device_path + ": not streaming");
+    return SourceResult::kError;
+  }
+  if (dequeued_index_ >= 0) {
+    *error = Status::Error(options_.device_path + ": previous buffer not requeued");
+    return SourceResult::kError;
+  }
+  const int ready = device_.poll(fd_, options_.poll_timeout_ms);
+  if (ready == 0) return SourceResult::kNoFrame;
+  if (ready < 0) {
+    *error = fail("poll", errno);
+    return SourceResult::kError;
+  }
+  v4l2_buffer buf{};
+  buf.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+  buf.memory = V4L2_MEMORY_MMAP;
+  if (device_.ioctl(fd_, VIDIOC_DQBUF, &buf) < 0) {
+    if (errno == EAGAIN) return SourceResult::kNoFrame;
+    *error = fail("VIDIOC_DQBUF", errno);
+    return SourceResult::kError;
+  }
+  if (buf.index >= buffers_.size() || buf.bytesused > buffers_[buf.index].length) {
+    *error = Status::Error(options_.device_path + ": VIDIOC_DQBUF returned an invalid buffer");
+    return SourceResult::kError;
+  }
+  dequeued_index_ = static_cast<int>(buf.index);
+  view->data = static_cast<const uint8_t*>(buffers_[buf.index].address);
+  view->bytes_used = buf.bytesused;
+  view->stride = stride_;
+  if ((buf.flags & V4L2_BUF_FLAG_TIMESTAMP_MASK) == V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC) {
+    view->timestamp_ns = static_cast<int64_t>(buf.timestamp.tv_sec) * 1000000000 +
+                         static_cast<int64_t>(buf.timestamp.tv_usec) * 1000;
+  } else {  // unknown clock: the dequeue time is the best host-monotonic stamp we have
+    timespec now{};
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    view->timestamp_ns = static_cast<int64_t>(now.tv_sec) * 1000000000 + now.tv_nsec;
+  }
+  view->sequence = buf.sequence;
+  return SourceResult::kFrame;
+}
+
+Status V4l2Capture::requeue() {
+  if (dequeued_index_ < 0) return Status::Ok();
+  const uint32_t index = static_cast<uint32_t>(dequeued_index_);
+  dequeued_index_ = -1;
+  return queueBuffer(index);
+}
+
+void V4l2Capture::close() {
+  if (fd_ < 0) return;
+  if (streaming_) {
+    v4l2_buf_type type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+    (void)device_.ioctl(fd_, VIDIOC_STREAMOFF, &type);  // fails harmlessly on a vanished device
+    streaming_ = false;
+  }
+  for (const MappedBuffer& b : buffers_) (void)device_.munmap(b.address, b.length);
+  buffers_.clear();
+  dequeued_index_ = -1;
+  (void)device_.close(fd_);
+  fd_ = -1;
+}
+
+}  // namespace plumb

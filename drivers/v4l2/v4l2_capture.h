@@ -1,0 +1,77 @@
+#pragma once
+// V4l2Capture: one V4L2 video node streaming into memory-mapped buffers, allocated once at open:
+//   open -> VIDIOC_QUERYCAP -> VIDIOC_S_FMT -> VIDIOC_S_PARM (frame rate, best effort)
+//        -> VIDIOC_REQBUFS -> VIDIOC_QUERYBUF + mmap per buffer -> VIDIOC_QBUF all
+//        -> VIDIOC_STREAMON;  per frame: poll -> VIDIOC_DQBUF ... VIDIOC_QBUF;
+//   close: VIDIOC_STREAMOFF -> munmap -> close.
+// Every failure names the device and the ioctl, e.g. "/dev/video2: VIDIOC_DQBUF failed: No such
+// device (device disconnected)".
+#include <cstdint>
+#include <string>
+
+#include "drivers/common/frame_source.h"
+#include "drivers/v4l2/v4l2_device.h"
+#include "platform/fixed_vector.h"
+#include "platform/status.h"
+
+namespace plumb {
+
+enum class V4l2PixelFormat { kYuyv, kMjpeg, kGrey, kZ16 };
+
+// "yuyv", "mjpeg", "grey", "z16".
+const char* pixelFormatName(V4l2PixelFormat format);
+bool parsePixelFormat(const std::string& name, V4l2PixelFormat* format);
+
+struct V4l2CaptureOptions {
+  std::string device_path;  // e.g. /dev/video0
+  V4l2PixelFormat format = V4l2PixelFormat::kYuyv;
+  int width = 640, height = 480;
+  int fps = 30;
+  int buffer_count = 4;       // enough to hold one for pairing while the driver fills the rest
+  int poll_timeout_ms = 100;  // kNoFrame after this long without a buffer (3 frames at 30 Hz)
+};
+
+// A dequeued buffer, valid until requeue().
+struct V4l2FrameView {
+  const uint8_t* data = nullptr;
+  std::size_t bytes_used = 0;
+  std::size_t stride = 0;     // bytes per line
+  int64_t timestamp_ns = 0;   // driver timestamp (CLOCK_MONOTONIC when the driver says so)
+  uint32_t sequence = 0;      // driver frame counter (gaps = frames the driver dropped)
+};
+
+class V4l2Capture {
+ public:
+  static constexpr int kMaxBuffers = 16;
+
+  explicit V4l2Capture(V4l2Device& device) : device_(device) {}
+  ~V4l2Capture() { close(); }
+  V4l2Capture(const V4l2Capture&) = delete;
+  V4l2Capture& operator=(const V4l2Capture&) = delete;
+
+  Status open(const V4l2CaptureOptions& options);
+  // kFrame: *view is valid until requeue(). kNoFrame: poll timed out. kError: *error says why.
+  SourceResult dequeue(V4l2FrameView* view, Status* error);
+  Status requeue();  // gives the buffer of the last dequeue() back to the driver
+  void close();      // best effort, never fails: also used after the device vanished
+  bool isOpen() const { return fd_ >= 0; }
+  const V4l2CaptureOptions& options() const { return options_; }
+
+ private:
+  struct MappedBuffer {
+    void* address = nullptr;
+    std::size_t length = 0;
+  };
+  Status fail(const char* what, int error_number) const;
+  Status queueBuffer(uint32_t index);
+
+  V4l2Device& device_;
+  V4l2CaptureOptions options_;
+  int fd_ = -1;
+  bool streaming_ = false;
+  std::size_t stride_ = 0;
+  FixedVector<MappedBuffer, kMaxBuffers> buffers_;
+  int dequeued_index_ = -1;  // buffer held by the caller, -1 = none
+};
+
+}  // namespace plumb
