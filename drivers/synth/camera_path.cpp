@@ -8,6 +8,8 @@
 namespace plumb::synth {
 namespace {
 constexpr double kDeg = M_PI / 180.0;
+// The gaze target lies this fraction of the camera-to-centre distance beyond the centre.
+constexpr double kLookAcross = 0.6;
 }
 
 CameraPath::CameraPath(const CameraPathOptions& options) : options_(options) {
@@ -47,8 +49,11 @@ Eigen::Isometry3d CameraPath::T_world_cam(double t_s) const {
   const double wobble = wave(radius_, 2, t_s);
   const Eigen::Vector3d p_world_cam(c.x() + (1.8 + wobble) * std::cos(angle),
                                     c.y() + (1.3 + wobble) * std::sin(angle), 1.35 + wave(height_, 2, t_s));
-  const Eigen::Vector3d target_world(c.x() + wave(target_x_, 2, t_s), c.y() + wave(target_y_, 2, t_s),
-                                     0.8 + wave(target_z_, 2, t_s));
+  // Gaze across the room: a target beyond the centre keeps the table in the lower part of the view
+  // and the furniture along the far wall in the upper part.
+  const Eigen::Vector2d across = (c.head<2>() - p_world_cam.head<2>()) * kLookAcross;
+  const Eigen::Vector3d target_world(c.x() + across.x() + wave(target_x_, 2, t_s),
+                                     c.y() + across.y() + wave(target_y_, 2, t_s), 0.9 + wave(target_z_, 2, t_s));
   // Look-at frame: forward to the target, right horizontal, down completing x right, y down, z forward.
   const Eigen::Vector3d forward = (target_world - p_world_cam).normalized();
   const Eigen::Vector3d right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();

@@ -67,7 +67,6 @@ void FrameRenderer::transformQuads(const Eigen::Isometry3d& T_world_cam) {
     qc.plane_offset = qc.normal.dot(qc.origin);
     qc.facing = qc.plane_offset < 0;  // the camera (origin) is on the front side
   }
-  lamp_cam_ = T_cam_world * model_.lamp_world;
 }
 
 void FrameRenderer::rasteriseQuad(int quad_index) {
@@ -149,35 +148,24 @@ int FrameRenderer::castRay(double u, double v, const int* candidates, int count,
 
 cv::Vec3f FrameRenderer::sampleTexture(const SurfaceTexture& texture, double s_m, double t_m) const {
   const cv::Mat& bgr = texture.bgr;
-  const double x = std::clamp(s_m * texture.texels_per_metre - 0.5, 0.0, bgr.cols - 1.0001);
-  const double y = std::clamp(t_m * texture.texels_per_metre - 0.5, 0.0, bgr.rows - 1.0001);
+  const float x = std::clamp(static_cast<float>(s_m * texture.texels_per_metre) - 0.5f, 0.0f, bgr.cols - 1.001f);
+  const float y = std::clamp(static_cast<float>(t_m * texture.texels_per_metre) - 0.5f, 0.0f, bgr.rows - 1.001f);
   const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
-  const float ax = static_cast<float>(x - x0), ay = static_cast<float>(y - y0);
-  const cv::Vec3b* row0 = bgr.ptr<cv::Vec3b>(y0) + x0;
-  const cv::Vec3b* row1 = bgr.ptr<cv::Vec3b>(y0 + 1) + x0;
-  cv::Vec3f result;
-  for (int k = 0; k < 3; ++k) {
-    const float top = row0[0][k] + ax * (row0[1][k] - row0[0][k]);
-    const float bottom = row1[0][k] + ax * (row1[1][k] - row1[0][k]);
-    result[k] = top + ay * (bottom - top);
-  }
-  return result;
+  const float ax = x - x0, ay = y - y0;
+  const uchar* p00 = bgr.ptr<uchar>(y0) + 3 * x0;
+  const uchar* p10 = p00 + bgr.step[0];
+  const float w00 = (1 - ax) * (1 - ay), w01 = ax * (1 - ay), w10 = (1 - ax) * ay, w11 = ax * ay;
+  return cv::Vec3f(w00 * p00[0] + w01 * p00[3] + w10 * p10[0] + w11 * p10[3],
+                   w00 * p00[1] + w01 * p00[4] + w10 * p10[1] + w11 * p10[4],
+                   w00 * p00[2] + w01 * p00[5] + w10 * p10[2] + w11 * p10[5]);
 }
 
 cv::Vec3f FrameRenderer::shadePoint(int quad_index, const Eigen::Vector3d& P_cam) const {
-  const SceneQuad& quad = model_.quads[quad_index];
+  // Lighting is baked into the texture (light_baking.h): shading is one bilinear lookup.
   const QuadInCamera& qc = quads_cam_[quad_index];
-  cv::Vec3f albedo = quad.albedo_bgr;
-  if (quad.texture >= 0) {
-    const Eigen::Vector3d offset = P_cam - qc.origin;
-    albedo = sampleTexture(model_.textures[quad.texture], offset.dot(qc.axis_u), offset.dot(qc.axis_v));
-  }
-  const Eigen::Vector3d to_lamp = lamp_cam_ - P_cam;
-  const double distance2 = to_lamp.squaredNorm();
-  const double cosine = std::max(0.0, qc.normal.dot(to_lamp)) / std::sqrt(distance2);
-  const float light = quad.directional_shade +
-                      static_cast<float>(model_.lamp_strength * cosine / (1.0 + distance2 / 4.0));
-  return albedo * light;
+  const Eigen::Vector3d offset = P_cam - qc.origin;
+  return sampleTexture(model_.textures[model_.quads[quad_index].texture], offset.dot(qc.axis_u),
+                       offset.dot(qc.axis_v));
 }
 
 void FrameRenderer::shadePixels() {

@@ -6,12 +6,13 @@
 //     to the near plane, projected, and filled span by span; depth at a pixel centre is the exact
 //     ray-plane intersection z = d / (n . r), so depth is exact up to float rounding (no
 //     interpolation error, which the reprojection test relies on).
-//  2. Shade: texture (bilinear) x (ambient + sun + soft lamp) at the pixel centre. Pixels whose
+//  2. Shade: a bilinear lookup in the face's texture, lighting baked in (light_baking.h). Pixels whose
 //     4-neighbours carry another quad id lie on a silhouette or crease: they are supersampled
 //     3x3 by ray casting against the quads of their 3x3 neighbourhood, so edges are anti-aliased
 //     and the line detector sees clean straight segments. Depth stays the centre sample (a real
 //     sensor does not blend depths either).
 // Shading is view-independent (Lambert), so a surface point has the same colour in every frame.
+// Every quad must have a texture (bakeLighting gives flat faces a light map).
 #include <cstdint>
 #include <vector>
 
@@ -57,7 +58,6 @@ class FrameRenderer {
   std::vector<QuadInCamera> quads_cam_;
   std::vector<double> ray_x_, ray_y_;  // (u - cx) / fx per column, (v - cy) / fy per row
   std::vector<int32_t> quad_id_;       // per pixel, -1 = nothing
-  Eigen::Vector3d lamp_cam_;
   cv::Mat colour_bgr_, depth_m_;
   int edge_pixels_ = 0;
 };

@@ -4,6 +4,9 @@
 
 #include <algorithm>
 
+#include <Eigen/Geometry>
+
+#include "drivers/synth/light_baking.h"
 #include "drivers/synth/surface_texture.h"
 #include "drivers/synth/synth_random.h"
 
@@ -15,7 +18,10 @@ using Eigen::Vector3d;
 class RoomBuilder {
  public:
   RoomBuilder(const RoomLayoutOptions& options, SceneModel& model)
-      : options_(options), model_(model), rng_(mix64(options.seed ^ 0x526f6f6dULL)) {}
+      : options_(options),
+        model_(model),
+        rng_(mix64(options.seed ^ 0x526f6f6dULL)),
+        texture_rng_(mix64(options.seed ^ 0x54657874ULL)) {}
 
   SplitMix64& rng() { return rng_; }
 
@@ -41,7 +47,8 @@ class RoomBuilder {
     double tpm = big ? options_.wall_texels_per_metre : options_.object_texels_per_metre;
     if (style == TextureStyle::kCeiling) tpm = options_.wall_texels_per_metre / 3;
     quad.texture = static_cast<int>(model_.textures.size());
-    model_.textures.push_back(makeSurfaceTexture(quad.length_u, quad.length_v, tpm, style, quad.albedo_bgr, rng_));
+    model_.textures.push_back(
+        makeSurfaceTexture(quad.length_u, quad.length_v, tpm, style, quad.albedo_bgr, texture_rng_));
   }
 
   // A framed picture on a wall whose inward normal is `normal` (axis-aligned, horizontal).
@@ -61,7 +68,9 @@ class RoomBuilder {
  private:
   const RoomLayoutOptions& options_;
   SceneModel& model_;
+  // Separate streams: both presets of one seed share the layout, only the textures differ.
   SplitMix64 rng_;
+  SplitMix64 texture_rng_;
 };
 
 void addShellAndTrim(RoomBuilder& b) {
@@ -197,7 +206,7 @@ SceneModel buildRoom(const RoomLayoutOptions& options) {
   addSouthWall(builder);
   addWestWall(builder);
   addCentre(builder);
-  computeDirectionalShading(model);
+  bakeLighting(model, options.lightmap_texels_per_metre);
   return model;
 }
 

@@ -15,6 +15,7 @@ struct RoomLayoutOptions {
   uint64_t seed = 1;
   double wall_texels_per_metre = 150;    // walls, floor (a 5-7 mm texel: ~1 px at 1 m)
   double object_texels_per_metre = 220;  // furniture faces
+  double lightmap_texels_per_metre = 16;  // untextured faces: a smooth baked light gradient
 };
 
 // Room interior bounds and the centre the camera circles.

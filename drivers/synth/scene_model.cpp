@@ -1,7 +1,5 @@
-// Box -> quads and per-face lighting for the synthetic room (see scene_model.h).
+// Box -> quads for the synthetic room (see scene_model.h).
 #include "drivers/synth/scene_model.h"
-
-#include <algorithm>
 
 namespace plumb::synth {
 
@@ -28,13 +26,6 @@ int addBox(SceneModel& model, const Eigen::Vector3d& min_world, const Eigen::Vec
     }
   }
   return first;
-}
-
-void computeDirectionalShading(SceneModel& model) {
-  for (SceneQuad& quad : model.quads) {
-    const double lit = std::max(0.0, -quad.normal_world.dot(model.sun_dir_world));
-    quad.directional_shade = static_cast<float>(model.ambient + model.sun_strength * lit);
-  }
 }
 
 }  // namespace plumb::synth

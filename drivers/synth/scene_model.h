@@ -1,6 +1,8 @@
 #pragma once
 // The synthetic room as the renderer sees it: a list of one-sided planar rectangles ("quads") in
 // the world frame, each with a flat colour or its own texture image, and one light setup.
+// Lighting is view-independent (Lambert), so light_baking.h multiplies it into the textures once
+// and rendering a pixel is a single texture lookup.
 //
 // Everything in the room is built from axis-aligned boxes (walls are the inside of one big box),
 // so a quad is origin + two perpendicular edges. A quad is visible only from its front (the side
@@ -19,9 +21,8 @@ struct SceneQuad {
   Eigen::Vector3d axis_v_world;  // unit vector along the second edge
   Eigen::Vector3d normal_world;  // unit front normal
   double length_u = 0, length_v = 0;  // edge lengths in metres
-  cv::Vec3f albedo_bgr;               // flat colour (0..255) when texture < 0
-  int texture = -1;                   // index into SceneModel::textures, or -1
-  float directional_shade = 1;        // ambient + directional light term, constant per face
+  cv::Vec3f albedo_bgr;               // flat colour (0..255) of untextured faces
+  int texture = -1;                   // index into SceneModel::textures, or -1 (until baked)
 };
 
 // A texture covers its quad exactly: texel (x, y) <-> (u, v) = ((x + 0.5), (y + 0.5)) / texels_per_metre.
@@ -53,8 +54,5 @@ enum BoxFace : unsigned {
 // (the room's walls). Returns the index of the first quad appended.
 int addBox(SceneModel& model, const Eigen::Vector3d& min_world, const Eigen::Vector3d& max_world,
            const cv::Vec3f& albedo_bgr, unsigned faces = kAllFaces, bool inward = false);
-
-// Sets every quad's directional_shade from the model's ambient and sun light.
-void computeDirectionalShading(SceneModel& model);
 
 }  // namespace plumb::synth
