@@ -138,7 +138,7 @@ void LocalBundleAdjuster::clear() {
 }
 
 int LocalBundleAdjuster::addKeyframe(const Eigen::Isometry3d& T_cam_world, bool fixed) {
-  if (num_keyframes_ >= static_cast<int>(keyframes_.size())) return -1;
+  if (num_keyframes_ >= static_cast<int>(keyframes_.size()) || !T_cam_world.matrix().allFinite()) return -1;
   Keyframe& kf = keyframes_[num_keyframes_];
   kf.T_cam_world = T_cam_world;
   kf.step.setZero();
@@ -149,7 +149,7 @@ int LocalBundleAdjuster::addKeyframe(const Eigen::Isometry3d& T_cam_world, bool 
 }
 
 int LocalBundleAdjuster::addLandmark(const Eigen::Vector3d& P_world) {
-  if (num_landmarks_ >= static_cast<int>(landmarks_.size())) return -1;
+  if (num_landmarks_ >= static_cast<int>(landmarks_.size()) || !P_world.allFinite()) return -1;
   Landmark& lm = landmarks_[num_landmarks_];
   lm.P_world = P_world;
   lm.step.setZero();
@@ -161,6 +161,7 @@ int LocalBundleAdjuster::addObservation(int keyframe, int landmark, ObservationK
                                         const Eigen::Vector3d& z, const Eigen::Matrix3d& information) {
   if (num_observations_ >= static_cast<int>(observations_.size())) return -1;
   if (keyframe < 0 || keyframe >= num_keyframes_ || landmark < 0 || landmark >= num_landmarks_) return -1;
+  if (!z.allFinite() || !information.allFinite()) return -1;  // would poison the whole solve
   Observation& obs = observations_[num_observations_];
   obs.keyframe = keyframe;
   obs.landmark = landmark;

@@ -117,8 +117,8 @@ class LocalBundleAdjuster {
   // Forget keyframes, landmarks and observations; keeps the reserved memory.
   void clear();
 
-  // Each add returns the new index, or -1 when the reserved capacity is full or an index is
-  // out of range (nothing is added then).
+  // Each add returns the new index, or -1 when the reserved capacity is full, an index is out
+  // of range or an input is not finite (nothing is added then).
   int addKeyframe(const Eigen::Isometry3d& T_cam_world, bool fixed);
   int addLandmark(const Eigen::Vector3d& P_world);
   int addStereoPointObservation(int keyframe, int landmark, const Eigen::Vector3d& z_uvr,
