@@ -112,7 +112,7 @@ TEST_F(SynthWriterTest, FilesFollowTheTumLayout) {
   const cv::Mat depth_raw = cv::imread((dir / "depth/1000.066667.png").string(), cv::IMREAD_UNCHANGED);
   ASSERT_EQ(bgr.type(), CV_8UC3);
   ASSERT_EQ(depth_raw.type(), CV_16UC1);
-  EXPECT_EQ(cv::countNonZero((bgr != frame.bgr).reshape(1)), 0);
+  EXPECT_EQ(cv::countNonZero(cv::Mat(bgr != frame.bgr).reshape(1)), 0);
   EXPECT_EQ(cv::countNonZero(depth_raw != frame.depth_raw), 0);
 }
 

@@ -17,11 +17,11 @@ std::unique_ptr<SyntheticScene> makeScene(const SynthOptions& options) {
 }
 
 bool sameBytes(const cv::Mat& a, const cv::Mat& b) {
-  return a.size() == b.size() && a.type() == b.type() && cv::countNonZero((a != b).reshape(1)) == 0;
+  return a.size() == b.size() && a.type() == b.type() && cv::countNonZero(cv::Mat(a != b).reshape(1)) == 0;
 }
 
 double fractionDiffering(const cv::Mat& a, const cv::Mat& b) {
-  cv::Mat differs = (a != b).reshape(1);
+  cv::Mat differs = cv::Mat(a != b).reshape(1);
   return static_cast<double>(cv::countNonZero(differs)) / differs.total();
 }
 
