@@ -1,0 +1,149 @@
+// plumb_bench_staged_odometry [DATASET_DIR] [--frames N] [--trace-dir DIR]
+// The runtime acceptance numbers on one sequence (default: fr1/rpy head250):
+//   1. the single-threaded processImage() loop (reference trajectory, frames per second);
+//   2. --mode deterministic three times: trajectories byte-identical to each other and to (1);
+//   3. --mode fast: frames per second over (1)  (target >= 1.6 on 2 cores);
+//   4. --mode realtime at the recorded rate: p99 end-to-end latency (target <= 33 ms), drops (0).
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <string>
+
+#include "drivers/common/open_source.h"
+#include "drivers/trajectory/trajectory_io.h"
+#include "pipeline/odometry_system.h"
+#include "platform/monotonic_time.h"
+#include "tools/staged_run.h"
+
+namespace plumb {
+namespace {
+
+struct Trajectory {
+  std::string tum;  // the bytes a trajectory file would hold
+  long frames = 0;
+  double seconds = 0;
+};
+
+void append(Trajectory* t, double timestamp_s, bool valid, const Eigen::Isometry3d& T_world_cam) {
+  StampedPose pose;
+  pose.timestamp = timestamp_s;
+  pose.valid = valid;
+  pose.T_world_cam = T_world_cam;
+  t->tum += formatTumLine(pose);
+}
+
+Status open(const std::string& dir, std::unique_ptr<FrameSource>* source) {
+  return openFrameSource(dir, "", source);
+}
+
+Status runSingleThreaded(const std::string& dir, long frames, Trajectory* out) {
+  std::unique_ptr<FrameSource> source;
+  PLUMB_RETURN_IF_ERROR(open(dir, &source));
+  OdometrySystem system(source->camera(), SystemOptions{});
+  auto on_frame = [&](const FinishedFrame& f) { append(out, f.timestamp_s, f.valid, f.T_world_cam); };
+  RgbdImage image;
+  const int64_t start = monotonicNowNs();
+  while (out->frames < frames) {
+    const SourceResult r = source->next(image);
+    if (r == SourceResult::kEndOfStream) break;
+    if (r != SourceResult::kFrame) return source->lastError();
+    system.processImage(image);
+    system.drainFinishedFrames(on_frame);
+    ++out->frames;
+  }
+  system.finish(on_frame, [](const RetiredKeyframe&) {});
+  out->seconds = static_cast<double>(monotonicNowNs() - start) * 1e-9;
+  return Status::Ok();
+}
+
+Status runMode(const std::string& dir, long frames, runtime::RunMode mode, const std::string& trace,
+               Trajectory* out, tools::StagedRunResult* result) {
+  std::unique_ptr<FrameSource> source;
+  PLUMB_RETURN_IF_ERROR(open(dir, &source));
+  OdometrySystem system(source->camera(), SystemOptions{});
+  auto on_frame = [&](const FinishedFrame& f) { append(out, f.timestamp_s, f.valid, f.T_world_cam); };
+  tools::StagedRunOptions options;
+  options.mode = mode;
+  options.max_frames = frames;
+  options.profile_path = trace;
+  options.print_profile = false;
+  const tools::FrameOutputFn on_output = [&](const FrameOutput&) {
+    system.drainFinishedFrames(on_frame);
+    ++out->frames;
+    return Status::Ok();
+  };
+  const int64_t start = monotonicNowNs();
+  PLUMB_RETURN_IF_ERROR(tools::runStaged(*source, system, options, on_output, result));
+  system.finish(on_frame, [](const RetiredKeyframe&) {});
+  out->seconds = static_cast<double>(monotonicNowNs() - start) * 1e-9;
+  return Status::Ok();
+}
+
+}  // namespace
+}  // namespace plumb
+
+int main(int argc, char** argv) {
+  using namespace plumb;
+  std::string dir = std::string(PLUMB_DATASETS_DIR) + "/tum_fr1_rpy_head250";
+  std::string trace_dir;
+  long frames = 250;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) {
+      frames = std::atol(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--trace-dir") && i + 1 < argc) {
+      trace_dir = argv[++i];
+    } else {
+      dir = argv[i];
+    }
+  }
+  auto trace = [&](const char* name) { return trace_dir.empty() ? std::string() : trace_dir + "/" + name; };
+  auto check = [](const Status& st) {
+    if (!st.ok()) {
+      std::fprintf(stderr, "plumb_bench_staged_odometry: %s\n", st.message().c_str());
+      std::exit(1);
+    }
+  };
+
+  Trajectory single;
+  check(runSingleThreaded(dir, frames, &single));
+  std::printf("single-threaded processImage loop: %ld frames, %.2f s, %.2f frames/s\n", single.frames,
+              single.seconds, single.frames / single.seconds);
+
+  bool identical = true;
+  for (int run = 0; run < 3; ++run) {
+    Trajectory t;
+    tools::StagedRunResult r;
+    check(runMode(dir, frames, runtime::RunMode::kDeterministic, "", &t, &r));
+    const bool same = t.tum == single.tum;
+    identical = identical && same;
+    std::printf("deterministic run %d: %ld frames, %.2f s, trajectory %s the single-threaded one (%zu bytes)\n",
+                run + 1, t.frames, t.seconds, same ? "byte-identical to" : "DIFFERS from", t.tum.size());
+  }
+
+  Trajectory fast;
+  tools::StagedRunResult fast_result;
+  check(runMode(dir, frames, runtime::RunMode::kFast, trace("fast.json"), &fast, &fast_result));
+  std::printf("\nfast:\n%s", runtime::formatRunReport(fast_result.report).c_str());
+  std::printf("fast trajectory %s the single-threaded one\n",
+              fast.tum == single.tum ? "byte-identical to" : "differs from");
+  std::printf("allocations after frame 30: %llu over %llu frames (%.1f per frame)\n",
+              static_cast<unsigned long long>(fast_result.allocations_after_warmup),
+              static_cast<unsigned long long>(fast_result.frames_after_warmup),
+              fast_result.frames_after_warmup
+                  ? static_cast<double>(fast_result.allocations_after_warmup) / fast_result.frames_after_warmup
+                  : 0.0);
+
+  Trajectory realtime;
+  tools::StagedRunResult realtime_result;
+  check(runMode(dir, frames, runtime::RunMode::kRealtime, trace("realtime.json"), &realtime, &realtime_result));
+  std::printf("\nrealtime:\n%s", runtime::formatRunReport(realtime_result.report).c_str());
+
+  std::printf("\nsummary\n");
+  std::printf("deterministic_identical %s\n", identical ? "yes" : "no");
+  std::printf("fast_over_single_threaded %.2f\n", fast.frames / fast.seconds / (single.frames / single.seconds));
+  std::printf("realtime_p99_end_to_end_ms %.2f\n",
+              static_cast<double>(realtime_result.report.end_to_end.percentileNs(0.99)) * 1e-6);
+  std::printf("realtime_dropped_frames %llu\n",
+              static_cast<unsigned long long>(realtime_result.report.frames_dropped));
+  return identical ? 0 : 1;
+}
