@@ -58,7 +58,8 @@ std::string formatChromeTrace(const std::vector<TraceTrack>& tracks, const RunRe
   out << "{\"displayTimeUnit\":\"ms\",\"otherData\":{\"producer\":\"plumb\",\"mode\":\""
       << escapeJson(report.mode) << "\",\"frames_read\":" << report.frames_read
       << ",\"frames_completed\":" << report.frames_completed
-      << ",\"frames_dropped\":" << report.frames_dropped << ",\"wall_ns\":" << report.wall_ns
+      << ",\"frames_dropped\":" << report.frames_dropped
+      << ",\"frames_late\":" << report.frames_late << ",\"wall_ns\":" << report.wall_ns
       << ",\"records_not_kept\":" << overflow << "},\n\"traceEvents\":[\n";
   out << "{\"name\":\"process_name\",\"ph\":\"M\",\"pid\":" << kPid
       << ",\"tid\":0,\"args\":{\"name\":\"plumb pipeline\"}}";
@@ -72,8 +73,9 @@ std::string formatChromeTrace(const std::vector<TraceTrack>& tracks, const RunRe
     const std::string name = escapeJson(tracks[tid].name());
     const bool last = tid + 1 == tracks.size();
     for (const TraceRecord& r : tracks[tid].records()) {
-      if (r.kind == TraceRecord::Kind::kDrop) {
-        out << ",\n{\"name\":\"drop\",\"cat\":\"drop\",\"ph\":\"i\",\"s\":\"t\",\"pid\":" << kPid
+      if (r.kind != TraceRecord::Kind::kSpan) {
+        const char* what = r.kind == TraceRecord::Kind::kDrop ? "drop" : "late";
+        out << ",\n{\"name\":\"" << what << "\",\"cat\":\"drop\",\"ph\":\"i\",\"s\":\"t\",\"pid\":" << kPid
             << ",\"tid\":" << tid << ",\"ts\":" << micros(r.t_start_ns - t0)
             << ",\"args\":{\"frame\":" << r.frame_index << "}}";
         continue;
@@ -130,6 +132,7 @@ Status parseChromeTrace(const std::string& text, RunReport* report) {
   std::map<int, LatencyHistogram> track_latency;
   std::map<int64_t, int64_t> e2e_begin_ns;  // frame -> begin time
   uint64_t drop_events = 0;
+  uint64_t late_events = 0;
   for (std::size_t i = 0; i < events->items.size(); ++i) {
     const JsonValue& e = events->items[i];
     const JsonValue* ph = e.find("ph");
@@ -158,7 +161,9 @@ Status parseChromeTrace(const std::string& text, RunReport* report) {
       }
       track_latency[track].add(nsFromMicros(dur->number));
     } else if (ph->string == "i") {
-      ++drop_events;
+      const JsonValue* name = e.find("name");
+      const bool late = name != nullptr && name->isString() && name->string == "late";
+      ++(late ? late_events : drop_events);
     } else if (ph->string == "b" || ph->string == "e") {
       const JsonValue* id = e.find("id");
       if (id == nullptr || !id->isNumber()) {
@@ -186,6 +191,7 @@ Status parseChromeTrace(const std::string& text, RunReport* report) {
   report->frames_read = counter(other, "frames_read");
   report->frames_completed = counter(other, "frames_completed");
   report->frames_dropped = std::max(counter(other, "frames_dropped"), drop_events);
+  report->frames_late = std::max(counter(other, "frames_late"), late_events);
   report->wall_ns = static_cast<int64_t>(counter(other, "wall_ns"));
   return Status::Ok();
 }

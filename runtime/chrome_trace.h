@@ -5,7 +5,8 @@
 // and chrome://tracing open directly:
 //   - one track (tid) per stage, named by "thread_name" metadata; tid 0 = the source;
 //   - a complete event ("ph":"X", ts/dur in microseconds) per stage step, args {"frame": n};
-//   - an instant event ("ph":"i") named "drop" on the source track per dropped frame;
+//   - an instant event ("ph":"i") on the source track per frame not processed: "drop" (no free
+//     slot) or "late" (the source was too far behind the frame's due time);
 //   - an async span ("ph":"b"/"e", cat "end_to_end", id = frame) from sensor time to the last
 //     stage's completion, so end-to-end latency shows as its own row;
 //   - "otherData": mode and frame counters (read, completed, dropped, wall time).

@@ -2,6 +2,7 @@
 // How a pipeline run is executed. Filled by tools/ from the command line; the runtime reads no
 // files or environment.
 #include <cstddef>
+#include <cstdint>
 #include <string>
 
 #include "platform/status.h"
@@ -32,6 +33,9 @@ struct RunOptions {
   std::size_t slot_count = 4;
   // nullptr: the real monotonic clock.
   Clock* clock = nullptr;
+  // Real-time mode: frames the source reaches more than this long after their due time are
+  // skipped and counted as late (the replay fell behind); <= 0: never skip.
+  int64_t max_source_lag_ns = 50'000'000;
   // Trace records kept per stage (preallocated); later frames are counted, not recorded.
   std::size_t trace_capacity_per_stage = 8192;
   // Stage threads: SCHED_FIFO priority (0 = normal scheduling) and pinning to CPU (i % cores).

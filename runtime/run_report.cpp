@@ -28,10 +28,12 @@ std::string formatRunReport(const RunReport& report) {
   for (const StageReport& stage : report.stages) appendRow(&out, stage.name, stage.latency);
   appendRow(&out, "end-to-end", report.end_to_end);
   std::snprintf(line, sizeof(line),
-                "mode %s: %llu frames read, %llu completed, %llu dropped, %.3f s, %.2f frames/s\n",
+                "mode %s: %llu frames read, %llu completed, %llu dropped (no free slot), %llu late "
+                "(source behind), %.3f s, %.2f frames/s\n",
                 report.mode.c_str(), static_cast<unsigned long long>(report.frames_read),
                 static_cast<unsigned long long>(report.frames_completed),
-                static_cast<unsigned long long>(report.frames_dropped), ms(report.wall_ns) * 1e-3,
+                static_cast<unsigned long long>(report.frames_dropped),
+                static_cast<unsigned long long>(report.frames_late), ms(report.wall_ns) * 1e-3,
                 report.framesPerSecond());
   out += line;
   return out;

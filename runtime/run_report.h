@@ -21,6 +21,8 @@ struct RunReport {
   uint64_t frames_read = 0;         // frames the source put into slots
   uint64_t frames_completed = 0;    // frames every stage processed
   uint64_t frames_dropped = 0;      // real-time mode: frames that found no free slot
+  uint64_t frames_late = 0;         // real-time mode: frames skipped because the source was more
+                                    // than RunOptions::max_source_lag_ns behind their due time
   int64_t wall_ns = 0;              // first source step to last frame done (run clock)
 
   double framesPerSecond() const {

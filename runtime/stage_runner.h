@@ -207,6 +207,18 @@ class StageRunner {
     tracks_[0].add({TraceRecord::Kind::kDrop, frame_index, t_ns, t_ns, t_ns});
   }
 
+  // Real-time replay: a frame whose capture would start more than max_source_lag_ns after its due
+  // time is skipped. Without this a source that cannot keep up (slow decoding) falls further
+  // behind every frame and the end-to-end latency grows without bound; a live sensor never
+  // delivers stale frames, its newer frame replaces the old one.
+  bool skipIfLate(uint64_t frame_index, int64_t t_due_ns, int64_t t_now_ns) {
+    if (options_.max_source_lag_ns <= 0 || t_now_ns - t_due_ns <= options_.max_source_lag_ns) return false;
+    source_.skip();
+    ++report_.frames_late;
+    tracks_[0].add({TraceRecord::Kind::kLate, frame_index, t_due_ns, t_now_ns, t_now_ns});
+    return true;
+  }
+
   // Threaded hand-off to stage `to` (lastStage() + 1: out of the pipeline).
   void send(int to, const PipelineMessage& m) {
     if (to > lastStage()) {

@@ -60,6 +60,7 @@ void StageRunner<T>::sourceLoop() {
     if (realtime()) {
       t_sensor_ns = pacedTimeNs(t_recorded_ns);
       clock_.sleepUntilNs(t_sensor_ns);
+      if (skipIfLate(frame_index, t_sensor_ns, clock_.nowNs())) continue;
       if (!pool_.tryAcquire(&slot)) {  // every slot busy: drop, never wait
         source_.skip();
         recordDrop(frame_index, clock_.nowNs());
@@ -154,6 +155,7 @@ void StageRunner<T>::runSimulated() {
       releaseDueBy(t_capture);
       clock.setNs(t_capture);
       const uint64_t frame_index = next_frame_index_++;
+      if (skipIfLate(frame_index, pacedTimeNs(t_recorded_ns), t_capture)) continue;
       SlotIndex slot = 0;
       if (!pool_.tryAcquire(&slot)) {
         source_.skip();

@@ -10,12 +10,12 @@
 namespace plumb::runtime {
 
 struct TraceRecord {
-  enum class Kind : uint8_t { kSpan, kDrop };
+  enum class Kind : uint8_t { kSpan, kDrop, kLate };  // kDrop: no free slot; kLate: source behind
   Kind kind = Kind::kSpan;
   uint64_t frame_index = 0;
   int64_t t_sensor_ns = 0;  // lets the last stage's records double as end-to-end spans
   int64_t t_start_ns = 0;
-  int64_t t_end_ns = 0;  // == t_start_ns for a drop
+  int64_t t_end_ns = 0;  // == t_start_ns for a drop or late frame
 };
 
 class TraceTrack {

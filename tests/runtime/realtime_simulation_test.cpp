@@ -100,6 +100,48 @@ TEST(RealtimeSimulation, FastEnoughStagesDropNothingAndLatencyIsTheirCost) {
   EXPECT_EQ(r.report.end_to_end.percentileNs(0.99), 12 * kMs);
 }
 
+TEST(RealtimeSimulation, ASourceThatFallsBehindSkipsLateFramesInsteadOfLaggingForever) {
+  // Reading a frame takes 15 ms but frames are due every 10 ms; frames reached more than 12 ms
+  // after their due time are skipped. By hand (capture start = max(due, source free)):
+  //   f0 due 0  start 0  lag 0    f1 due 10 start 15 lag 5    f2 due 20 start 30 lag 10
+  //   f3 due 30 start 45 lag 15 -> late (skipping costs nothing)
+  //   f4 due 40 start 45 lag 5    f5 due 50 start 60 lag 10   f6 due 60 start 75 lag 15 -> late
+  //   f7 due 70 start 75 lag 5    f8 due 80 start 90 lag 10   f9 due 90 start 105 lag 15 -> late
+  VirtualClock clock;
+  ToySource source(10, 10 * kMs, -1, &clock, 15 * kMs);
+  MixStage mix;
+  FoldStage fold(10);
+  RunOptions options;
+  options.mode = RunMode::kRealtime;
+  options.clock = &clock;
+  options.max_source_lag_ns = 12 * kMs;
+  StageRunner<ToyFrame> runner(source, {&mix, &fold}, options);
+  ASSERT_TRUE(runner.run().ok());
+  std::vector<uint64_t> late;
+  for (const TraceRecord& r : runner.trace()[0].records()) {
+    if (r.kind == TraceRecord::Kind::kLate) late.push_back(r.frame_index);
+  }
+  EXPECT_EQ(late, (std::vector<uint64_t>{3, 6, 9}));
+  EXPECT_EQ(runner.report().frames_late, 3u);
+  EXPECT_EQ(runner.report().frames_dropped, 0u);
+  EXPECT_EQ(fold.frameIndices(), (std::vector<uint64_t>{0, 1, 2, 4, 5, 7, 8}));
+  // End to end includes the source's lag: f2 was due at 20 and done at 45.
+  EXPECT_EQ(runner.report().end_to_end.maxNs(), 25 * kMs);
+  EXPECT_EQ(source.consumed(), 10u);
+
+  // Without the limit every frame is read, ever later: f9 is due at 90 and done at 150.
+  VirtualClock clock2;
+  ToySource source2(10, 10 * kMs, -1, &clock2, 15 * kMs);
+  FoldStage fold2(10);
+  options.clock = &clock2;
+  options.max_source_lag_ns = 0;
+  StageRunner<ToyFrame> unlimited(source2, {&mix, &fold2}, options);
+  ASSERT_TRUE(unlimited.run().ok());
+  EXPECT_EQ(unlimited.report().frames_late, 0u);
+  EXPECT_EQ(unlimited.report().frames_completed, 10u);
+  EXPECT_EQ(unlimited.report().end_to_end.maxNs(), 60 * kMs);
+}
+
 TEST(RealtimeSimulation, IsReproducible) {
   const Simulated a = simulate(200, 10 * kMs, 3, 13 * kMs, 9 * kMs);
   const Simulated b = simulate(200, 10 * kMs, 3, 13 * kMs, 9 * kMs);

@@ -19,9 +19,12 @@ struct ToyFrame {
 
 class ToySource final : public Source<ToyFrame> {
  public:
-  // frame_count frames, recorded period_ns apart. fail_at: read() of that frame fails.
-  ToySource(uint64_t frame_count, int64_t period_ns, int64_t fail_at = -1)
-      : frame_count_(frame_count), period_ns_(period_ns), fail_at_(fail_at) {}
+  // frame_count frames, recorded period_ns apart. fail_at: read() of that frame fails. With a
+  // clock, each read() takes read_cost_ns of virtual time.
+  ToySource(uint64_t frame_count, int64_t period_ns, int64_t fail_at = -1,
+            VirtualClock* clock = nullptr, int64_t read_cost_ns = 0)
+      : frame_count_(frame_count), period_ns_(period_ns), fail_at_(fail_at), clock_(clock),
+        read_cost_ns_(read_cost_ns) {}
 
   bool peekNext(int64_t* t_recorded_ns) override {
     if (next_ >= frame_count_) return false;
@@ -30,6 +33,7 @@ class ToySource final : public Source<ToyFrame> {
   }
   Status read(ToyFrame& frame, const FrameStamps&) override {
     const uint64_t n = next_++;
+    if (clock_ != nullptr) clock_->advanceNs(read_cost_ns_);
     if (static_cast<int64_t>(n) == fail_at_) return Status::Error("frame " + std::to_string(n) + " unreadable");
     frame = ToyFrame{};
     frame.value = n * 0x9E3779B97F4A7C15ull + 1;
@@ -42,6 +46,8 @@ class ToySource final : public Source<ToyFrame> {
   uint64_t frame_count_;
   int64_t period_ns_;
   int64_t fail_at_;
+  VirtualClock* clock_;
+  int64_t read_cost_ns_;
   uint64_t next_ = 0;
 };
 
