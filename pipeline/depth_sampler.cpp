@@ -17,7 +17,7 @@ DepthSampler::DepthSampler(const PinholeCamera& camera, const ExtractorOptions& 
   intrinsics_.bf = camera.fx * camera.baseline_m;
 }
 
-float DepthSampler::depthAt(const cv::Mat& depth_raw, double depth_factor, int x, int y,
+float DepthSampler::depthAt(const cv::Mat& depth_raw, double depth_factor, float xf, float yf,
                             bool prefer_near_surface) const {
   const float inv_factor = static_cast<float>(1.0 / depth_factor);
   const float min_d = options_.min_depth_m, max_d = options_.max_depth_m;
@@ -26,6 +26,19 @@ float DepthSampler::depthAt(const cv::Mat& depth_raw, double depth_factor, int x
     const float d = depth_raw.at<uint16_t>(v, u) * inv_factor;
     return (d >= min_d && d <= max_d) ? d : 0.f;
   };
+  // Depth jump that separates two surfaces: a few sigmas, at least 2 cm.
+  auto discontinuity = [&](float d) { return std::max(0.02f, 4 * static_cast<float>(depthSigma(options_.noise, d))); };
+  const int x0 = static_cast<int>(std::floor(xf)), y0 = static_cast<int>(std::floor(yf));
+  const float d00 = read(x0, y0), d10 = read(x0 + 1, y0), d01 = read(x0, y0 + 1), d11 = read(x0 + 1, y0 + 1);
+  const float lo = std::min(std::min(d00, d10), std::min(d01, d11));
+  const float hi = std::max(std::max(d00, d10), std::max(d01, d11));
+  if (lo > 0 && hi - lo < discontinuity(lo)) {
+    const float ax = xf - x0, ay = yf - y0;
+    return (1 - ay) * ((1 - ax) * d00 + ax * d10) + ay * ((1 - ax) * d01 + ax * d11);
+  }
+  const int x = static_cast<int>(std::lround(xf)), y = static_cast<int>(std::lround(yf));
+  const float centre = read(x, y);
+  if (!prefer_near_surface) return centre;
   // Nearest valid reading in the (2r+1)^2 window, 0 if none.
   auto nearest = [&](int r) {
     float best = 0;
@@ -37,25 +50,44 @@ float DepthSampler::depthAt(const cv::Mat& depth_raw, double depth_factor, int x
     }
     return best;
   };
-  const float centre = read(x, y);
-  if (prefer_near_surface && options_.depth_edge_radius_px > 0) {
+  if (options_.depth_edge_radius_px > 0) {
     const float near = nearest(options_.depth_edge_radius_px);
     // On an occluding edge the centre pixel may read the background: if the window holds a
     // clearly nearer surface (beyond a few depth sigmas), that surface is the one the edge belongs to.
     if (centre == 0) {
       if (near > 0) return near;
     } else {
-      const float sigma = static_cast<float>(depthSigma(options_.noise, centre));
-      return (centre - near > std::max(0.02f, 4 * sigma)) ? near : centre;
+      return (centre - near > discontinuity(near)) ? near : centre;
     }
   } else if (centre > 0) {
     return centre;
   }
+  // A hole: the nearest reading in a widening window.
   for (int r = std::max(1, options_.depth_edge_radius_px + 1); r <= options_.depth_hole_radius_px; ++r) {
     const float d = nearest(r);
     if (d > 0) return d;
   }
   return 0.f;
+}
+
+bool DepthSampler::onDepthEdge(const cv::Mat& depth_raw, double depth_factor, const Eigen::Vector2f& px) const {
+  const int r = options_.keypoint_edge_radius_px;
+  if (r <= 0) return false;
+  const int x = static_cast<int>(std::lround(px.x())), y = static_cast<int>(std::lround(px.y()));
+  const int x0 = std::max(0, x - r), x1 = std::min(depth_raw.cols - 1, x + r);
+  const int y0 = std::max(0, y - r), y1 = std::min(depth_raw.rows - 1, y + r);
+  int lo = 1 << 20, hi = 0;
+  for (int v = y0; v <= y1; ++v) {
+    const uint16_t* row = depth_raw.ptr<uint16_t>(v);
+    for (int u = x0; u <= x1; ++u) {
+      if (row[u] == 0) continue;  // holes are not surfaces
+      lo = std::min<int>(lo, row[u]);
+      hi = std::max<int>(hi, row[u]);
+    }
+  }
+  if (hi == 0) return false;
+  const float near = static_cast<float>(lo / depth_factor), far = static_cast<float>(hi / depth_factor);
+  return far - near > std::max(0.02f, 4 * static_cast<float>(depthSigma(options_.noise, near)));
 }
 
 void DepthSampler::attachDepth(const cv::Mat& depth_raw, double depth_factor, FrameFeatures& features) const {
@@ -66,10 +98,8 @@ void DepthSampler::attachDepth(const cv::Mat& depth_raw, double depth_factor, Fr
     kp.u_right = -1;
     kp.info_uvr.setZero();
     if (!has_depth) continue;
-    const int x = static_cast<int>(std::lround(kp.px.x())), y = static_cast<int>(std::lround(kp.px.y()));
-    if (x < 0 || y < 0 || x >= depth_raw.cols || y >= depth_raw.rows) continue;
-    const float d = depth_raw.at<uint16_t>(y, x) / static_cast<float>(depth_factor);
-    if (!(d >= options_.min_depth_m && d <= options_.max_depth_m)) continue;
+    const float d = depthAt(depth_raw, depth_factor, kp.px.x(), kp.px.y(), false);
+    if (d <= 0 || onDepthEdge(depth_raw, depth_factor, kp.px)) continue;
     kp.depth_m = d;
     kp.u_right = kp.px_undist.x() - bf / d;
     kp.P_cam = camera_.unproject(kp.px_undist.x(), kp.px_undist.y(), d).cast<float>();
@@ -93,8 +123,7 @@ void DepthSampler::sampleLine(const cv::Mat& depth_raw, double depth_factor, Lin
     const float t = n == 1 ? 0.5f : margin + (1 - 2 * margin) * k / static_cast<float>(n - 1);
     const Eigen::Vector2f uv = line.start_px + t * (line.end_px - line.start_px);
     const Eigen::Vector2d raw = camera_.distortPoint(uv.x(), uv.y());
-    const float d = depthAt(depth_raw, depth_factor, static_cast<int>(std::lround(raw.x())),
-                            static_cast<int>(std::lround(raw.y())), true);
+    const float d = depthAt(depth_raw, depth_factor, static_cast<float>(raw.x()), static_cast<float>(raw.y()), true);
     if (d <= 0) continue;
     px[valid] = uv;
     depth[valid] = d;

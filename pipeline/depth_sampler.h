@@ -2,7 +2,8 @@
 // DepthSampler: attaches registered depth to the features of one frame.
 //   keypoints: depth read at the raw (distorted) pixel `px` (depth is registered to the colour
 //     image, which is distorted); valid -> depth_m, u_right = u - bf/d, P_cam from px_undist,
-//     info_uvr from the paper's noise model (solver/noise_model.h); invalid -> 2D-only.
+//     info_uvr from the paper's noise model (solver/noise_model.h); invalid, or on a depth
+//     discontinuity (keypoint_edge_radius_px) -> 2D-only.
 //   lines: N line-guidance samples evenly on the undistorted segment (ends excluded by a margin),
 //     depth read at each sample's distorted pixel -- with the nearer surface preferred at depth
 //     discontinuities and a widening search in holes -- back-projected with their 3D covariance,
@@ -24,12 +25,17 @@ class DepthSampler {
   // depth_raw: CV_16UC1 camera-sized (or empty: everything stays 2D-only).
   void attachDepth(const cv::Mat& depth_raw, double depth_factor, FrameFeatures& features) const;
 
-  // Depth (m) at integer raw pixel (x, y): the centre reading, or the nearest surface in the
-  // edge window when the centre is a hole or sits on the far side of a discontinuity, or the
-  // nearest reading within the hole radius. 0 when nothing valid.
-  float depthAt(const cv::Mat& depth_raw, double depth_factor, int x, int y, bool prefer_near_surface) const;
+  // Depth (m) at sub-pixel raw position (x, y). On a smooth surface (the 4 neighbours valid and
+  // within the discontinuity threshold) the bilinear interpolation -- exact enough on slanted
+  // planes, where rounding to a pixel costs centimetres at grazing angles. Otherwise the nearest
+  // pixel's reading; with prefer_near_surface (line samples), the nearest surface in the edge
+  // window when that pixel is a hole or sits on the far side of a discontinuity, then the nearest
+  // reading within the hole radius. 0 when nothing valid.
+  float depthAt(const cv::Mat& depth_raw, double depth_factor, float x, float y, bool prefer_near_surface) const;
 
  private:
+  // True when the depth around `px` (raw pixel) spans two surfaces.
+  bool onDepthEdge(const cv::Mat& depth_raw, double depth_factor, const Eigen::Vector2f& px) const;
   void sampleLine(const cv::Mat& depth_raw, double depth_factor, LineObservation& line) const;
 
   PinholeCamera camera_;

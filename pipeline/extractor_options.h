@@ -26,6 +26,10 @@ struct ExtractorOptions {
   // ---- Depth ---------------------------------------------------------------------------------
   float min_depth_m = 0.2f;       // readings outside [min, max] are treated as holes
   float max_depth_m = 8.0f;
+  // A keypoint whose depth window (radius in px) spans a depth discontinuity stays 2D-only:
+  // corners on silhouettes are usually T-junctions of two surfaces, so no single depth (and no
+  // fixed 3D point) belongs to them. 0 disables the check.
+  int keypoint_edge_radius_px = 2;
 
   // ---- Line-guidance samples (paper V-D) -------------------------------------------------------
   int line_samples = 5;           // N points per line; 0 = points only; <= kMaxLineSamples

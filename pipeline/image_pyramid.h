@@ -2,6 +2,10 @@
 // ImagePyramid: the grey image at num_levels scales (level i is 1/scale^i of level 0) plus a
 // Gaussian-blurred copy of every level for the binary descriptors.
 //
+// Allocation: the blur is our own separable filter (cv::GaussianBlur builds a filter engine, ~10
+// heap allocations per call); cv::resize is kept (SIMD, and it makes exactly 2 small allocations
+// per call, measured by tests/pipeline/allocation_test.cpp and documented in docs/FRONTEND.md).
+//
 // All levels live as ROIs of ONE buffer whose row stride is level 0's width, so a pixel offset
 // (dy * stride + dx) means the same thing on every level: the rotated-BRIEF and FAST offset
 // tables are computed once. Buffers are allocated in the constructor; build() only writes.
@@ -29,7 +33,11 @@ class ImagePyramid {
  private:
   int num_levels_;
   std::array<float, kPyramidLevels> scales_{};
+  void blur(const cv::Mat& src, cv::Mat& dst);
+
   cv::Mat buffer_, blurred_buffer_;
+  cv::Mat row_filtered_;            // CV_16UC1 level-0 size: horizontal pass of the blur
+  std::array<int, 7> kernel_{};     // 7-tap Gaussian, sigma 2, fixed point (sum 256)
   std::array<cv::Mat, kPyramidLevels> levels_, blurred_levels_;
 };
 

@@ -34,6 +34,8 @@ LineExtractor::LineExtractor(const PinholeCamera& camera, const ExtractorOptions
 }
 
 void LineExtractor::extract(const ImagePyramid& pyramid, FrameFeatures& out) {
+  last_raw_segments_ = 0;
+  if (options_.max_lines <= 0) return;  // points only: LSD is not even run
   const int level = std::clamp(options_.line_level, 0, pyramid.numLevels() - 1);
   const cv::Mat& image = pyramid.level(level);
   lsd_->detect(image, segments_);

@@ -29,7 +29,7 @@ namespace plumb {
 struct PointMatcherOptions {
   float search_radius_px = 15;   // at octave 0; grows with scale^octave
   int hamming_threshold = 50;    // accept when best distance <= this (ORB-SLAM TH_HIGH = 100, LOW = 50)
-  float ratio = 0.9f;            // best < ratio * second best
+  float ratio = 0.8f;            // best < ratio * second best
   bool check_orientation = true;
   int orientation_bins = 30;
   int octave_tolerance = 1;      // accept observed octave within +-this of the predicted one
