@@ -7,6 +7,7 @@
 #include "drivers/common/text_lines.h"
 #include "drivers/dataset/camera_presets.h"
 #include "drivers/dataset/tum_dataset.h"
+#include "drivers/recording/sensor_source_specs.h"
 #include "drivers/synth/synthetic_scene.h"
 
 namespace plumb {
@@ -72,6 +73,7 @@ Status openFrameSource(const std::string& spec, const std::string& camera_spec,
                        std::unique_ptr<FrameSource>* out) {
   if (spec.empty()) return Status::Error("empty source specification");
   if (spec.rfind(kSynthPrefix, 0) == 0) return openSynthetic(spec, camera_spec, out);
+  if (isSensorOrRecordingSpec(spec)) return openSensorOrRecordingSource(spec, camera_spec, out);
 
   // A dataset folder: an explicit camera wins, then the folder's camera.txt, then the sensor its
   // name tells; otherwise refuse rather than guess intrinsics (a wrong camera fails silently).

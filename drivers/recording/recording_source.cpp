@@ -52,6 +52,15 @@ void RecordingSource::rewind() {
   last_error_ = Status::Ok();
 }
 
+Status RecordingSource::overrideCamera(const PinholeCamera& camera) {
+  if (camera.width != camera_.width || camera.height != camera_.height)
+    return Status::Error(path_ + ": camera is " + std::to_string(camera.width) + "x" +
+                         std::to_string(camera.height) + " but the recording is " +
+                         std::to_string(camera_.width) + "x" + std::to_string(camera_.height));
+  camera_ = camera;
+  return Status::Ok();
+}
+
 std::size_t RecordingSource::readAt(uint64_t offset, uint8_t* dst, std::size_t n) {
   if (fseeko(file_, static_cast<off_t>(offset), SEEK_SET) != 0) return 0;
   return std::fread(dst, 1, n, file_);

@@ -40,6 +40,8 @@ class RecordingSource : public FrameSource {
 
   const RecordingStats& stats() const { return stats_; }
   void rewind();
+  // Replaces the recorded intrinsics (e.g. a later calibration). The image size must match.
+  Status overrideCamera(const PinholeCamera& camera);
 
  private:
   RecordingSource() = default;

@@ -1,0 +1,89 @@
+#include "drivers/recording/sensor_source_specs.h"
+
+#include "drivers/dataset/camera_presets.h"
+#include "drivers/fault/resilient_source.h"
+#include "drivers/openni2/openni2_source.h"
+#include "drivers/recording/recording_source.h"
+#include "drivers/v4l2/v4l2_source.h"
+
+namespace plumb {
+namespace {
+
+bool startsWith(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
+bool endsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+std::unique_ptr<FrameSource> supervised(std::unique_ptr<FrameSource> live) {
+  return std::make_unique<ResilientSource>(std::move(live), ResilientSourceOptions{});
+}
+
+Status openRecording(const std::string& path, const std::string& camera_spec,
+                     std::unique_ptr<FrameSource>* out) {
+  std::unique_ptr<RecordingSource> source;
+  PLUMB_RETURN_IF_ERROR(RecordingSource::open(path, &source));
+  if (!camera_spec.empty()) {
+    PinholeCamera camera;
+    PLUMB_RETURN_IF_ERROR(cameraFromSpec(camera_spec, &camera));
+    PLUMB_RETURN_IF_ERROR(source->overrideCamera(camera));
+  }
+  *out = std::move(source);
+  return Status::Ok();
+}
+
+Status openOpenNI2(const std::string& uri, const std::string& camera_spec,
+                   std::unique_ptr<FrameSource>* out) {
+  PinholeCamera fallback;
+  if (!camera_spec.empty()) PLUMB_RETURN_IF_ERROR(cameraFromSpec(camera_spec, &fallback));
+  OpenNI2SourceOptions options;
+  options.uri = uri == "first" ? "" : uri;
+  std::unique_ptr<FrameSource> source;
+  PLUMB_RETURN_IF_ERROR(
+      openOpenNI2Source(options, camera_spec.empty() ? nullptr : &fallback, &source));
+  *out = source->isLive() ? supervised(std::move(source)) : std::move(source);
+  return Status::Ok();
+}
+
+Status openV4l2(const std::string& spec, const std::string& camera_spec,
+                std::unique_ptr<FrameSource>* out) {
+  std::string nodes = spec.substr(5);  // after "v4l2:"
+  V4l2SourceOptions options;
+  const std::size_t colon = nodes.rfind(':');
+  if (colon != std::string::npos) {
+    if (!parsePixelFormat(nodes.substr(colon + 1), &options.colour_format))
+      return Status::Error(spec + ": unknown colour format '" + nodes.substr(colon + 1) +
+                           "' (yuyv mjpeg grey)");
+    nodes = nodes.substr(0, colon);
+  }
+  const std::size_t comma = nodes.find(',');
+  options.colour_device = nodes.substr(0, comma);
+  if (comma != std::string::npos) options.depth_device = nodes.substr(comma + 1);
+  if (options.colour_device.empty())
+    return Status::Error(spec + ": expected v4l2:/dev/videoN[,/dev/videoM][:FORMAT]");
+  if (camera_spec.empty())
+    return Status::Error(spec + ": V4L2 reports no intrinsics; pass a camera file or preset");
+  PinholeCamera camera;
+  PLUMB_RETURN_IF_ERROR(cameraFromSpec(camera_spec, &camera));
+  std::unique_ptr<V4l2Source> source;
+  PLUMB_RETURN_IF_ERROR(V4l2Source::open(options, camera, systemV4l2Device(), &source));
+  *out = supervised(std::move(source));
+  return Status::Ok();
+}
+
+}  // namespace
+
+bool isSensorOrRecordingSpec(const std::string& spec) {
+  return endsWith(spec, ".plumbrec") || endsWith(spec, ".oni") || startsWith(spec, "openni2:") ||
+         startsWith(spec, "v4l2:");
+}
+
+Status openSensorOrRecordingSource(const std::string& spec, const std::string& camera_spec,
+                                   std::unique_ptr<FrameSource>* out) {
+  if (endsWith(spec, ".plumbrec")) return openRecording(spec, camera_spec, out);
+  if (endsWith(spec, ".oni")) return openOpenNI2(spec, camera_spec, out);
+  if (startsWith(spec, "openni2:")) return openOpenNI2(spec.substr(8), camera_spec, out);
+  if (startsWith(spec, "v4l2:")) return openV4l2(spec, camera_spec, out);
+  return Status::Error(spec + ": not a sensor or recording specification");
+}
+
+}  // namespace plumb

@@ -1,0 +1,21 @@
+#pragma once
+// Source specifications of the sensor and recording sources, for openFrameSource():
+//   FILE.plumbrec                      our recording (brings its camera; --camera overrides it)
+//   FILE.oni                           an OpenNI recording, through OpenNI2
+//   openni2:first | openni2:URI        a live OpenNI2 device (camera: device FOV, else --camera)
+//   v4l2:/dev/videoN[,/dev/videoM][:FORMAT]
+//                                      UVC colour node [+ Z16 depth node]; FORMAT yuyv (default),
+//                                      mjpeg or grey; needs --camera (V4L2 reports no intrinsics)
+// Live sources come wrapped in a ResilientSource (reopen with backoff after errors/stalls).
+#include <memory>
+#include <string>
+
+#include "drivers/common/frame_source.h"
+
+namespace plumb {
+
+bool isSensorOrRecordingSpec(const std::string& spec);
+Status openSensorOrRecordingSource(const std::string& spec, const std::string& camera_spec,
+                                   std::unique_ptr<FrameSource>* out);
+
+}  // namespace plumb

@@ -1,0 +1,109 @@
+// plumb convert: TUM/ICL folder -> .plumbrec recording, and .plumbrec -> TUM folder.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+
+#include "drivers/common/open_source.h"
+#include "drivers/recording/recording_source.h"
+#include "drivers/recording/recording_writer.h"
+#include "drivers/recording/tum_folder_writer.h"
+#include "tools/args.h"
+#include "tools/command.h"
+
+namespace {
+
+void printHelp() {
+  std::printf(
+      "usage: plumb convert IN OUT [--camera SPEC]\n"
+      "  IN a TUM/ICL folder, OUT.plumbrec   -> a lossless recording (camera from --camera, the\n"
+      "                                         folder's camera.txt, or its sensor name)\n"
+      "  IN.plumbrec, OUT a new folder       -> TUM layout: rgb/ depth/ rgb.txt depth.txt\n"
+      "                                         associations.txt camera.txt\n"
+      "Pixels and timestamps are preserved exactly both ways. A damaged recording converts up to\n"
+      "the damage it can skip; what was skipped is reported.\n");
+}
+
+int fail(const std::string& message) {
+  std::fprintf(stderr, "plumb convert: %s\n", message.c_str());
+  return 1;
+}
+
+int folderToRecording(const std::string& in, const std::string& out, const std::string& camera) {
+  std::unique_ptr<plumb::FrameSource> source;
+  plumb::Status st = plumb::openFrameSource(in, camera, &source);
+  if (!st.ok()) return fail(st.message());
+  std::unique_ptr<plumb::RecordingWriter> writer;
+  st = plumb::RecordingWriter::open(out, source->camera(), {}, &writer);
+  if (!st.ok()) return fail(st.message());
+  plumb::RgbdImage frame;
+  for (;;) {
+    const plumb::SourceResult r = source->next(frame);
+    if (r == plumb::SourceResult::kEndOfStream) break;
+    if (r != plumb::SourceResult::kFrame) return fail(source->lastError().message());
+    st = writer->append(frame);
+    if (!st.ok()) return fail(st.message());
+  }
+  st = writer->close();
+  if (!st.ok()) return fail(st.message());
+  std::printf("%s -> %s: %llu frames, %.1f MB\n", in.c_str(), out.c_str(),
+              static_cast<unsigned long long>(writer->framesWritten()), writer->bytesWritten() / 1e6);
+  return 0;
+}
+
+int recordingToFolder(const std::string& in, const std::string& out, const std::string& camera) {
+  std::unique_ptr<plumb::FrameSource> opened;
+  plumb::Status st = plumb::openFrameSource(in, camera, &opened);
+  if (!st.ok()) return fail(st.message());
+  auto* recording = dynamic_cast<plumb::RecordingSource*>(opened.get());
+  std::unique_ptr<plumb::TumFolderWriter> writer;
+  st = plumb::TumFolderWriter::open(out, opened->camera(), &writer);
+  if (!st.ok()) return fail(st.message());
+  plumb::RgbdImage frame;
+  for (;;) {
+    const plumb::SourceResult r = opened->next(frame);
+    if (r == plumb::SourceResult::kEndOfStream) break;
+    if (r != plumb::SourceResult::kFrame) return fail(opened->lastError().message());
+    st = writer->append(frame);
+    if (!st.ok()) return fail(st.message());
+  }
+  st = writer->close();
+  if (!st.ok()) return fail(st.message());
+  std::printf("%s -> %s: %llu frames\n", in.c_str(), out.c_str(),
+              static_cast<unsigned long long>(writer->framesWritten()));
+  if (recording) {
+    const plumb::RecordingStats& s = recording->stats();
+    if (s.chunks_skipped > 0 || s.truncated_tail_bytes > 0 || !s.end_chunk_seen)
+      std::printf("damage: %llu chunks skipped (%llu bytes), %llu truncated tail bytes, %s; last: %s\n",
+                  static_cast<unsigned long long>(s.chunks_skipped),
+                  static_cast<unsigned long long>(s.bytes_skipped),
+                  static_cast<unsigned long long>(s.truncated_tail_bytes),
+                  s.end_chunk_seen ? "closed properly" : "not closed properly",
+                  s.last_damage.empty() ? "-" : s.last_damage.c_str());
+  }
+  return 0;
+}
+
+int runConvert(int argc, char** argv) {
+  const plumb::tools::Args args(argc, argv, {"camera"}, {});
+  if (args.help()) {
+    printHelp();
+    return 0;
+  }
+  if (!args.error().empty() || args.positional().size() != 2) {
+    std::fprintf(stderr, "plumb convert: %s (see plumb convert --help)\n",
+                 args.error().empty() ? "need IN and OUT" : args.error().c_str());
+    return 2;
+  }
+  const std::string in = args.positional()[0], out = args.positional()[1];
+  const bool in_is_folder = std::filesystem::is_directory(in);
+  const bool out_is_recording = out.size() > 9 && out.compare(out.size() - 9, 9, ".plumbrec") == 0;
+  const bool in_is_recording = in.size() > 9 && in.compare(in.size() - 9, 9, ".plumbrec") == 0;
+  if (in_is_folder && out_is_recording) return folderToRecording(in, out, args.get("camera"));
+  if (in_is_recording && !out_is_recording) return recordingToFolder(in, out, args.get("camera"));
+  return fail("convert a folder to FILE.plumbrec, or FILE.plumbrec to a folder (got '" + in +
+              "' -> '" + out + "')");
+}
+
+}  // namespace
+
+PLUMB_COMMAND(convert, "convert a TUM/ICL folder to a .plumbrec recording and back", runConvert);
