@@ -44,19 +44,36 @@ int runSynth(int argc, char** argv) {
     return 2;
   }
   plumb::SynthOptions options;
-  bool ok = true;
+  // Each numeric option is parsed on its own so that an error names it.
+  std::string malformed;
+  auto number = [&](const char* key, double fallback) {
+    bool ok = true;
+    const double value = args.getDouble(key, fallback, &ok);
+    if (!ok && malformed.empty()) malformed = key;
+    return value;
+  };
+  auto integer = [&](const char* key, long fallback) {
+    bool ok = true;
+    const long value = args.getInt(key, fallback, &ok);
+    if (!ok && malformed.empty()) malformed = key;
+    return value;
+  };
   options.preset = args.get("preset", options.preset);
-  const long seed = args.getInt("seed", 1, &ok);
-  const long frames = args.getInt("frames", options.frames, &ok);
+  const long seed = integer("seed", 1);
+  const long frames = integer("frames", options.frames);
   options.frames = frames > 100000000L ? -1 : static_cast<int>(frames);  // absurd counts fail validate()
-  options.fps = args.getDouble("fps", options.fps, &ok);
-  options.loop_period_s = args.getDouble("loop-period", options.loop_period_s, &ok);
-  options.pixel_noise_sigma = args.getDouble("pixel-noise", options.pixel_noise_sigma, &ok);
-  options.depth_noise_k = args.getDouble("depth-noise-k", options.depth_noise_k, &ok);
+  options.fps = number("fps", options.fps);
+  options.loop_period_s = number("loop-period", options.loop_period_s);
+  options.pixel_noise_sigma = number("pixel-noise", options.pixel_noise_sigma);
+  options.depth_noise_k = number("depth-noise-k", options.depth_noise_k);
   options.depth_noise = args.has("depth-noise");
   options.depth_edge_holes = args.has("holes");
-  if (!ok || seed < 0) {
-    std::fprintf(stderr, "plumb synth: a numeric option is malformed (seed must be a non-negative integer)\n");
+  if (!malformed.empty()) {
+    std::fprintf(stderr, "plumb synth: --%s '%s' is not a number\n", malformed.c_str(), args.get(malformed).c_str());
+    return 2;
+  }
+  if (seed < 0) {
+    std::fprintf(stderr, "plumb synth: --seed must be a non-negative integer\n");
     return 2;
   }
   options.seed = static_cast<uint64_t>(seed);
@@ -64,7 +81,7 @@ int runSynth(int argc, char** argv) {
   const auto start = std::chrono::steady_clock::now();
   const plumb::Status status = plumb::writeSynthDataset(options, args.get("out"));
   if (!status.ok()) {
-    std::fprintf(stderr, "plumb synth: %s\n", status.message().c_str());
+    std::fprintf(stderr, "plumb: %s\n", status.message().c_str());  // messages name "synth:" or the file
     return 1;
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

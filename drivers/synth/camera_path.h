@@ -1,16 +1,16 @@
 #pragma once
-// The synthetic camera's trajectory: a smooth closed loop around the middle of the room, looking
-// at the table (so the view always holds furniture, floor and a far wall 2-7 m away), with
-// hand-held-like wobble.
+// The synthetic camera's trajectory: a smooth closed loop around the middle of the room, gazing
+// across it (the table in the lower part of the view, furniture along the far wall 2-7 m away
+// above it), with hand-held-like wobble.
 //
 // Every term is a sinusoid whose frequency is an integer multiple of 1 / period_s, so the path is
 // C-infinity and exactly periodic: a run longer than one lap repeats it without a seam.
 //   position: ellipse with radii 1.8 m x 1.3 m around the room centre, radius wobble +-0.14 m,
-//             height 1.35 m +-0.13 m
-//   gaze:     looks at a target wandering +-0.45 m around the table top, plus small fast jitter
-//             (~1 Hz, +-2 deg) like a hand; roll +-5 deg
-//   fast:     rotation_scale > 1 scales the wobble and adds yaw/pitch swings of
-//             +-14*scale / +-4*scale deg at 0.25 Hz (scale 2.5: peaks near 80 deg/s)
+//             height 1.35 m +-0.13 m (one lap ~10 m: ~0.5 m/s with the default 20 s period)
+//   gaze:     a target 0.6x the camera-centre distance beyond the centre, at 0.9 m height,
+//             wandering +-0.45 m slowly, plus ~1 Hz hand jitter; roll +-5.5 deg
+//   fast:     rotation_scale > 1 scales the gaze wander, jitter and roll and adds yaw / pitch
+//             swings of +-14*scale / +-4*scale deg at 0.25 / 0.35 Hz (period 20 s)
 #include <cstdint>
 
 #include <Eigen/Geometry>
@@ -20,7 +20,7 @@ namespace plumb::synth {
 struct CameraPathOptions {
   uint64_t seed = 1;            // phases of every sinusoid and the starting angle on the loop
   double period_s = 20.0;       // one lap
-  double rotation_scale = 1.0;  // 1: hand-held; 2.5: "fast_rotation"
+  double rotation_scale = 1.0;  // 1: hand-held; 2: "fast_rotation"
   Eigen::Vector3d centre_world = Eigen::Vector3d(3.75, 3.0, 0.0);  // floor point the path circles
 };
 

@@ -23,7 +23,7 @@ struct Preset {
 constexpr Preset kPresets[] = {
     {"textured", true, 1.0},
     {"low_texture", false, 1.0},
-    {"fast_rotation", true, 2.5},
+    {"fast_rotation", true, 2.0},
 };
 
 const Preset* findPreset(const std::string& name) {

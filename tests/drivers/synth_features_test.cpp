@@ -2,6 +2,8 @@
 // on the very same geometry, but still many long straight edges.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -41,9 +43,11 @@ TEST(SynthFeatures, LowTextureHasFewCornersButManyLongLines) {
     SCOPED_TRACE("frame " + std::to_string(frame));
     const FeatureCounts textured = countFeatures("textured", frame);
     const FeatureCounts low = countFeatures("low_texture", frame);
+    std::printf("frame %d: FAST corners textured %d, low_texture %d; LSD >= 40 px textured %d, low_texture %d\n", frame,
+                textured.corners, low.corners, textured.long_lines, low.long_lines);
     EXPECT_GT(textured.corners, 1000);
     EXPECT_LT(low.corners * 4, textured.corners) << low.corners << " vs " << textured.corners;
-    EXPECT_GE(low.long_lines, 15) << "the low-texture case must be rich in lines";
+    EXPECT_GE(low.long_lines, 25) << "the low-texture case must be rich in lines";
   }
 }
 

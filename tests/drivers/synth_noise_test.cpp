@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "drivers/synth/synthetic_scene.h"
 
@@ -56,6 +57,7 @@ TEST(SynthNoise, DepthSigmaGrowsWithDepthSquared) {
     ASSERT_GT(count[b], 5000) << "bin " << b;
     sigma[b] = std::sqrt(sum_sq[b] / count[b]);
     const double expected = options.depth_noise_k * std::sqrt(sum_z2sq[b] / count[b]);
+    std::printf("depth %d-%d m: sigma %.5f m, k z^2 %.5f m\n", b + 1, b + 2, sigma[b], expected);
     EXPECT_NEAR(sigma[b] / expected, 1.0, 0.06) << "depth bin " << b + 1 << "-" << b + 2 << " m";
   }
   // Quadratic, not linear: from ~1.5 m to ~4.5 m sigma grows ~9x (linear would be 3x).
@@ -116,6 +118,7 @@ TEST(SynthNoise, HolesOnlyOnTheFarSideOfDepthEdges) {
         }
       unexplained += !nearer;
     }
+  std::printf("holes: %d of %d valid pixels\n", holes, valid);
   EXPECT_EQ(unexplained, 0);
   EXPECT_GT(holes, 0.002 * valid) << "the frame has depth edges, so it must have holes";
   EXPECT_LT(holes, 0.08 * valid);

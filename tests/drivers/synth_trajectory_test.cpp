@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <vector>
 
 #include "drivers/synth/synthetic_scene.h"
@@ -53,6 +54,9 @@ TEST(SynthTrajectory, SmoothHandHeldMotionOverSeveralMetres) {
     auto scene = makeScene("textured", seed, 300);
     const PathStatistics stats = measure(*scene, 300);
     SCOPED_TRACE("seed " + std::to_string(seed));
+    std::printf("seed %llu: travel %.2f m in 300 frames, max step %.4f m %.3f deg, max jerk %.5f m %.4f deg\n",
+                static_cast<unsigned long long>(seed), stats.travel_m, stats.max_step_m, stats.max_step_deg,
+                stats.max_jerk_m, stats.max_jerk_deg);
     EXPECT_GT(stats.travel_m, 3.0) << "several metres in the default 10 s";
     EXPECT_LT(stats.max_step_m, 0.035) << "at most ~1 m/s";
     EXPECT_LT(stats.max_step_deg, 2.5) << "at most ~75 deg/s";
@@ -66,6 +70,7 @@ TEST(SynthTrajectory, FastRotationTurnsFasterOnTheSamePath) {
   auto normal = makeScene("textured", 4, 600);
   auto fast = makeScene("fast_rotation", 4, 600);
   const PathStatistics a = measure(*normal, 600), b = measure(*fast, 600);
+  std::printf("max rotation per frame: textured %.3f deg, fast_rotation %.3f deg\n", a.max_step_deg, b.max_step_deg);
   EXPECT_GT(b.max_step_deg, 1.8 * a.max_step_deg);
   EXPECT_NEAR(a.travel_m, b.travel_m, 1e-9) << "only the rotation changes";
 }
