@@ -47,7 +47,9 @@ FrameRenderer::FrameRenderer(const SceneModel& model, const PinholeCamera& camer
 
 void FrameRenderer::render(const Eigen::Isometry3d& T_world_cam) {
   transformQuads(T_world_cam);
-  depth_m_.setTo(std::numeric_limits<float>::infinity());
+  // Plain fill: cv::Mat::setTo allocates a scratch buffer on every call.
+  float* depth = depth_m_.ptr<float>();
+  std::fill(depth, depth + depth_m_.total(), std::numeric_limits<float>::infinity());
   std::fill(quad_id_.begin(), quad_id_.end(), -1);
   for (int q = 0; q < static_cast<int>(quads_cam_.size()); ++q)
     if (quads_cam_[q].facing) rasteriseQuad(q);

@@ -77,7 +77,7 @@ void addShellAndTrim(RoomBuilder& b) {
   const double W = kRoomWidth, D = kRoomDepth, H = kRoomHeight;
   // Walls, floor, ceiling: distinct shades (the low-texture case relies on face contrast).
   const cv::Vec3f wall_base = b.colour({170, 180, 190}, 30);
-  const float wall_gain[4] = {1.0f, 0.82f, 1.12f, 0.9f};
+  const float wall_gain[4] = {1.0f, 0.74f, 1.16f, 0.86f};  // adjacent walls differ clearly
   for (int w = 0; w < 4; ++w) {
     const unsigned face = 1u << w;  // kFaceMinX, kFaceMaxX, kFaceMinY, kFaceMaxY
     b.box(Vector3d::Zero(), Vector3d(W, D, H), b.colour(wall_base * wall_gain[w], 8), TextureStyle::kWall, face, true);
