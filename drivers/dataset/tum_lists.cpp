@@ -33,6 +33,8 @@ Status checkIncreasing(const std::string& where, const char* what, double previo
                        std::to_string(previous_line) + ")");
 }
 
+bool startsWith(const std::string& text, const char* prefix) { return text.rfind(prefix, 0) == 0; }
+
 }  // namespace
 
 Status readTumImageList(const std::string& list_path, std::vector<TumListEntry>* out) {
@@ -69,11 +71,15 @@ Status readTumAssociations(const std::string& list_path, std::vector<TumFrameEnt
     if (line.tokens.size() != 4)
       return Status::Error(where + ": expected `t_rgb rgb_file t_depth depth_file`, got " +
                            std::to_string(line.tokens.size()) + " fields");
+    // The benchmark writes rgb first; some tools (and ICL-NUIM's TUM-format release) write
+    // depth first. The folder names of the paths say which column is which.
+    const bool depth_first = startsWith(line.tokens[1], "depth") && startsWith(line.tokens[3], "rgb");
+    const int rgb_column = depth_first ? 2 : 0, depth_column = depth_first ? 0 : 2;
     TumFrameEntry entry;
-    PLUMB_RETURN_IF_ERROR(parseStamp(where, line.tokens[0], &entry.rgb_timestamp_s));
-    entry.rgb_path = line.tokens[1];
-    PLUMB_RETURN_IF_ERROR(parseStamp(where, line.tokens[2], &entry.depth_timestamp_s));
-    entry.depth_path = line.tokens[3];
+    PLUMB_RETURN_IF_ERROR(parseStamp(where, line.tokens[rgb_column], &entry.rgb_timestamp_s));
+    entry.rgb_path = line.tokens[rgb_column + 1];
+    PLUMB_RETURN_IF_ERROR(parseStamp(where, line.tokens[depth_column], &entry.depth_timestamp_s));
+    entry.depth_path = line.tokens[depth_column + 1];
     if (!out->empty()) {
       PLUMB_RETURN_IF_ERROR(checkIncreasing(where, "rgb", out->back().rgb_timestamp_s,
                                             previous_line, entry.rgb_timestamp_s));
