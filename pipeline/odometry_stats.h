@@ -1,0 +1,21 @@
+#pragma once
+// Counters of a run of the odometry system (reported by `plumb run --stats`).
+#include <cstdint>
+
+namespace plumb {
+
+struct OdometryStats {
+  uint64_t frames = 0;
+  uint64_t frames_ok = 0;
+  uint64_t frames_weak = 0;
+  uint64_t frames_lost = 0;             // no pose output
+  uint64_t frames_not_initialized = 0;  // before the first map
+  uint64_t frames_motion_fallback = 0;  // constant velocity failed, wide/zero-motion retry used
+  uint64_t keyframes = 0;
+  uint64_t relocalizations = 0;
+  uint64_t relocalization_attempts = 0;
+  uint64_t segments = 0;                // maps started (1 = never restarted)
+  uint64_t extraction_failures = 0;     // image did not match the camera
+};
+
+}  // namespace plumb

@@ -1,0 +1,30 @@
+#pragma once
+// Tracking state of a frame and what the tracker reports about it.
+#include <cstdint>
+
+#include <Eigen/Geometry>
+
+namespace plumb {
+
+enum class TrackingState : uint8_t {
+  kNotInitialized,  // no map yet (waiting for a frame with enough depth features)
+  kOk,              // enough inliers
+  kWeak,            // pose kept but support is thin: a keyframe is forced to refresh the map
+  kLost,            // pose not trusted: relocalization runs, the frame is marked lost
+};
+
+const char* toString(TrackingState state);
+
+struct TrackResult {
+  TrackingState state = TrackingState::kNotInitialized;
+  Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
+  int frame_matches = 0;       // point + line matches from the last frame
+  int local_map_matches = 0;   // point + line matches added from the local map
+  int point_inliers = 0;       // after the final pose optimisation
+  int line_inliers = 0;        // lines with a majority of inlier samples
+  int landmark_inliers = 0;    // inliers that are map landmarks (not last-frame depth points)
+  bool used_motion_fallback = false;  // constant velocity failed; wide / zero-motion retry used
+  bool keyframe_requested = false;
+};
+
+}  // namespace plumb
