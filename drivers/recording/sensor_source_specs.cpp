@@ -1,8 +1,12 @@
 #include "drivers/recording/sensor_source_specs.h"
 
+#include <cstdlib>
+
+#include "drivers/common/open_source.h"
 #include "drivers/dataset/camera_presets.h"
 #include "drivers/fault/resilient_source.h"
 #include "drivers/openni2/openni2_source.h"
+#include "drivers/recording/paced_source.h"
 #include "drivers/recording/recording_source.h"
 #include "drivers/v4l2/v4l2_source.h"
 
@@ -70,15 +74,36 @@ Status openV4l2(const std::string& spec, const std::string& camera_spec,
   return Status::Ok();
 }
 
+// paced:SPEC or paced@SPEED:SPEC around any other specification.
+Status openPaced(const std::string& spec, const std::string& camera_spec,
+                 std::unique_ptr<FrameSource>* out) {
+  const std::size_t colon = spec.find(':');
+  PacedSourceOptions options;
+  if (spec[5] == '@') {
+    char* end = nullptr;
+    const std::string speed = spec.substr(6, colon == std::string::npos ? std::string::npos : colon - 6);
+    options.speed = std::strtod(speed.c_str(), &end);
+    if (speed.empty() || *end != '\0' || !(options.speed > 0))
+      return Status::Error(spec + ": speed '" + speed + "' is not a positive number");
+  }
+  if (colon == std::string::npos || colon + 1 >= spec.size())
+    return Status::Error(spec + ": expected paced:SPEC or paced@SPEED:SPEC");
+  std::unique_ptr<FrameSource> inner;
+  PLUMB_RETURN_IF_ERROR(openFrameSource(spec.substr(colon + 1), camera_spec, &inner));
+  *out = std::make_unique<PacedSource>(std::move(inner), options);
+  return Status::Ok();
+}
+
 }  // namespace
 
 bool isSensorOrRecordingSpec(const std::string& spec) {
-  return endsWith(spec, ".plumbrec") || endsWith(spec, ".oni") || startsWith(spec, "openni2:") ||
-         startsWith(spec, "v4l2:");
+  return startsWith(spec, "paced:") || startsWith(spec, "paced@") || endsWith(spec, ".plumbrec") ||
+         endsWith(spec, ".oni") || startsWith(spec, "openni2:") || startsWith(spec, "v4l2:");
 }
 
 Status openSensorOrRecordingSource(const std::string& spec, const std::string& camera_spec,
                                    std::unique_ptr<FrameSource>* out) {
+  if (startsWith(spec, "paced:") || startsWith(spec, "paced@")) return openPaced(spec, camera_spec, out);
   if (endsWith(spec, ".plumbrec")) return openRecording(spec, camera_spec, out);
   if (endsWith(spec, ".oni")) return openOpenNI2(spec, camera_spec, out);
   if (startsWith(spec, "openni2:")) return openOpenNI2(spec.substr(8), camera_spec, out);

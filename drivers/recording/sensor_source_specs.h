@@ -6,6 +6,7 @@
 //   v4l2:/dev/videoN[,/dev/videoM][:FORMAT]
 //                                      UVC colour node [+ Z16 depth node]; FORMAT yuyv (default),
 //                                      mjpeg or grey; needs --camera (V4L2 reports no intrinsics)
+//   paced:SPEC | paced@SPEED:SPEC      replay SPEC at its recorded rate (x SPEED), like a sensor
 // Live sources come wrapped in a ResilientSource (reopen with backoff after errors/stalls).
 #include <memory>
 #include <string>

@@ -92,6 +92,26 @@ TEST(SensorSpecs, RecordingsOpenThroughOpenFrameSourceAndTheCameraCanBeOverridde
   EXPECT_NE(missing.message().find("none.plumbrec"), std::string::npos) << missing.message();
 }
 
+TEST(SensorSpecs, PacedWrapsAnySpec) {
+  test::ScratchDir dir("paced");
+  const std::string path = dir.file("p.plumbrec");
+  {
+    std::unique_ptr<RecordingWriter> rec;
+    ASSERT_TRUE(RecordingWriter::open(path, test::smallCamera(8, 6), {}, &rec).ok());
+    for (const RgbdImage& f : test::makeNoiseFrames(2, 8, 6, 3)) ASSERT_TRUE(rec->append(f).ok());
+  }
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(openFrameSource("paced@4:" + path, "", &source).ok());
+  EXPECT_EQ(source->describe(), "paced(plumbrec:" + path + ")");
+  RgbdImage out;
+  int frames = 0;
+  while (source->next(out) == SourceResult::kFrame) ++frames;  // 2 x 33 ms / 4: ~17 ms total
+  EXPECT_EQ(frames, 3);
+  EXPECT_EQ(openFrameSource("paced@fast:" + path, "", &source).message(),
+            "paced@fast:" + path + ": speed 'fast' is not a positive number");
+  EXPECT_FALSE(openFrameSource("paced:", "", &source).ok());
+}
+
 TEST(SensorSpecs, SensorSpecErrorsAreClear) {
   std::unique_ptr<FrameSource> source;
   EXPECT_EQ(openFrameSource("v4l2:/dev/video0", "", &source).message(),
