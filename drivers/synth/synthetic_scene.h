@@ -31,12 +31,14 @@ struct SynthOptions {
   // Appearance and motion of the scene:
   //   "textured"      rich procedural texture everywhere (blobs, noise, posters, checkers): many corners
   //   "low_texture"   plain faces in flat, distinct shades: strong straight edges, few corners
-  //   "fast_rotation" the textured room with a faster, more rotational hand-held motion
+  //   "fast_rotation" the textured room with a faster, more rotational hand-held motion (~2.4x
+//                   the peak angular rate; same path)
+// Both appearances of one seed share the geometry and the trajectory.
   std::string preset = "textured";
   // Everything random (layout jitter, colours, textures, trajectory phases, noise) derives from it.
   uint64_t seed = 1;
   // Frames rendered. The camera path is a closed loop of `loop_period_s`; longer runs repeat it
-  // smoothly (so a 10,000-frame run is many identical laps).
+  // smoothly (so a 10,000-frame run is many identical laps: no separate `loops` count needed).
   int frames = 300;
   double fps = 30.0;
   // Duration of one lap of the closed camera path. One lap is ~9 m of travel, so the default
