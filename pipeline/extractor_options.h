@@ -22,6 +22,9 @@ struct ExtractorOptions {
   // Pyramid level LSD runs on (0 = full resolution). Level 4 (scale 1.2^4 = 2.07) is ~half
   // resolution: 4x fewer pixels, endpoints are scaled back up to level-0 pixels.
   int line_level = 4;
+  // Detector: our lean LSD-style detector (line_segment_detector.h, ~1 ms at level 4, allocation
+  // free) or OpenCV imgproc's LineSegmentDetector (~6.4 ms at level 4, allocates per call).
+  bool use_opencv_lsd = false;
 
   // ---- Depth ---------------------------------------------------------------------------------
   float min_depth_m = 0.2f;       // readings outside [min, max] are treated as holes

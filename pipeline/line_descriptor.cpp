@@ -34,10 +34,12 @@ void computeLineDescriptor(const cv::Mat& image, const cv::Point2f& start, const
     const float offset = static_cast<float>(r - half_rows);
     const float weight = std::exp(-0.5f * offset * offset / (sigma * sigma));
     std::array<float, kStats>& stats = band[r / w];
-    for (int k = 0; k < positions; ++k) {
-      const float t = (k + 0.5f) / positions;
-      const int x = static_cast<int>(std::lround(start.x + t * dx + offset * nx));
-      const int y = static_cast<int>(std::lround(start.y + t * dy + offset * ny));
+    // Walk the row incrementally; +0.5 then truncation rounds (coordinates are >= 0 inside).
+    const float step_x = dx / positions, step_y = dy / positions;
+    float fx = start.x + 0.5f * step_x + offset * nx + 0.5f, fy = start.y + 0.5f * step_y + offset * ny + 0.5f;
+    for (int k = 0; k < positions; ++k, fx += step_x, fy += step_y) {
+      if (fx < 1 || fy < 1) continue;
+      const int x = static_cast<int>(fx), y = static_cast<int>(fy);
       if (x < 1 || y < 1 || x > x_max || y > y_max) continue;
       const uint8_t* p = data + y * stride + x;
       const float gx = static_cast<float>(p[1] - p[-1]);

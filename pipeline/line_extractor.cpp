@@ -25,10 +25,13 @@ void setLineGeometry(const Eigen::Vector2f& start_px, const Eigen::Vector2f& end
 }
 
 LineExtractor::LineExtractor(const PinholeCamera& camera, const ExtractorOptions& options)
-    : camera_(camera), options_(options) {
+    : camera_(camera), options_(options), detector_(camera.width, camera.height) {
   // No refinement and scale 1: we hand LSD an already downsampled pyramid level. The other
   // parameters are LSD's published defaults (sigma 0.6, quantisation 2, 22.5 deg, density 0.7).
-  lsd_ = cv::createLineSegmentDetector(cv::LSD_REFINE_NONE, 1.0, 0.6, 2.0, 22.5, 0.0, 0.7, 1024);
+  if (options.use_opencv_lsd) {
+    lsd_ = cv::createLineSegmentDetector(cv::LSD_REFINE_NONE, 1.0, 0.6, 2.0, 22.5, 0.0, 0.7, 1024);
+  }
+  detected_.resize(kSegmentReserve);
   segments_.reserve(kSegmentReserve);
   ranked_.reserve(kSegmentReserve);
 }
@@ -38,9 +41,17 @@ void LineExtractor::extract(const ImagePyramid& pyramid, FrameFeatures& out) {
   if (options_.max_lines <= 0) return;  // points only: LSD is not even run
   const int level = std::clamp(options_.line_level, 0, pyramid.numLevels() - 1);
   const cv::Mat& image = pyramid.level(level);
-  lsd_->detect(image, segments_);
-  last_raw_segments_ = static_cast<int>(segments_.size());
   const float scale = pyramid.scale(level);
+  if (lsd_) {
+    lsd_->detect(image, segments_);
+  } else {
+    // Our detector applies the length filter itself (in level pixels).
+    const int n = detector_.detect(image, 0.9f * options_.min_line_length_px / scale, detected_.data(),
+                                   static_cast<int>(detected_.size()));
+    segments_.clear();
+    for (int i = 0; i < n; ++i) segments_.emplace_back(detected_[i].x0, detected_[i].y0, detected_[i].x1, detected_[i].y1);
+  }
+  last_raw_segments_ = static_cast<int>(segments_.size());
 
   // Pixel centres: level pixel x covers level-0 [x*s, (x+1)*s), centre (x + 0.5) * s - 0.5.
   auto toLevel0 = [scale](float x) { return (x + 0.5f) * scale - 0.5f; };

@@ -1,12 +1,14 @@
 #pragma once
-// LineExtractor: LSD segments on one pyramid level (OpenCV imgproc's LineSegmentDetector, no
-// refinement, no internal rescale: the pyramid already did that), scaled back to level-0 pixels,
+// LineExtractor: line segments on one pyramid level -- our LSD-style detector
+// (line_segment_detector.h) or, with use_opencv_lsd, OpenCV imgproc's LineSegmentDetector (no
+// refinement, no internal rescale: the pyramid already did that) -- scaled back to level-0 pixels,
 // filtered by minimum length, the best max_lines kept (longest first: length is what makes a
 // segment both repeatable and well-constrained), endpoints undistorted, normalised 2D line
 // coefficients computed, and an LBD-style descriptor attached.
 //
-// Allocation: cv::LineSegmentDetector::detect allocates its internal images and region lists on
-// every call (documented in docs/FRONTEND.md); the output vector keeps its reserved capacity.
+// Allocation: none with our detector. cv::LineSegmentDetector::detect allocates its internal
+// images and region lists on every call (documented in docs/FRONTEND.md); the output vector keeps
+// its reserved capacity.
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -17,6 +19,7 @@
 #include "pipeline/frame_features.h"
 #include "pipeline/image_pyramid.h"
 #include "pipeline/line_descriptor.h"
+#include "pipeline/line_segment_detector.h"
 
 namespace plumb {
 
@@ -32,7 +35,9 @@ class LineExtractor {
   PinholeCamera camera_;
   ExtractorOptions options_;
   LineDescriptorOptions descriptor_options_;
-  cv::Ptr<cv::LineSegmentDetector> lsd_;
+  cv::Ptr<cv::LineSegmentDetector> lsd_;  // only with use_opencv_lsd
+  LineSegmentDetector detector_;
+  std::vector<DetectedSegment> detected_;  // sized once
   std::vector<cv::Vec4f> segments_;  // reserved once
   std::vector<std::pair<float, int>> ranked_;  // (length, index), reserved once
   int last_raw_segments_ = 0;

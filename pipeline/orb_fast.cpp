@@ -78,26 +78,26 @@ void FastDetector::scan(int threshold, int x0, int y0, int x1, int y1) {
   for (int y = y0; y < y_end; ++y) {
     const uint8_t* row = image.ptr<uint8_t>(y);
     uint8_t* score_row = score_.ptr<uint8_t>(y);
-    int x = x0;
-    // Rejection test 16 pixels at a time: an arc of 9 of 16 always covers at least two of the
-    // four compass pixels, so a corner needs >= 2 of them brighter (or darker) than the centre.
-    for (; x + 16 <= x_end; x += 16) {
-      const cv::v_uint8x16 c = cv::v_load(row + x);
+    // One block of 16 pixels starting at bx; lanes below `first_lane` were done already.
+    auto block = [&](int bx, int first_lane) {
+      const cv::v_uint8x16 c = cv::v_load(row + bx);
       const cv::v_uint8x16 hi = c + t, lo = c - t;  // saturating
+      // Rejection test: an arc of 9 of 16 always covers at least two of the four compass
+      // pixels, so a corner needs >= 2 of them brighter (or darker) than the centre.
       cv::v_uint8x16 bright = cv::v_setzero_u8(), dark = cv::v_setzero_u8();
       for (int k = 0; k < 4; ++k) {
-        const cv::v_uint8x16 q = cv::v_load(row + x + compass[k]);
+        const cv::v_uint8x16 q = cv::v_load(row + bx + compass[k]);
         bright += (q > hi) & one;
         dark += (q < lo) & one;
       }
       const cv::v_uint8x16 maybe = (bright >= two) | (dark >= two);
-      if (!cv::v_check_any(maybe)) continue;
+      if (!cv::v_check_any(maybe)) return;
       // Score of all 16 lanes at once, in saturating u8 arithmetic: with b_k = sat(I_k - c) and
       // e_k = sat(c - I_k), the score is the max over the 16 arcs of 9 of min(b) or min(e);
       // a pixel is a corner exactly when its score exceeds the threshold (the segment test).
       cv::v_uint8x16 b[32], e[32];
       for (int k = 0; k < 16; ++k) {
-        const cv::v_uint8x16 q = cv::v_load(row + x + circle[k]);
+        const cv::v_uint8x16 q = cv::v_load(row + bx + circle[k]);
         b[k] = b[k + 16] = q - c;
         e[k] = e[k + 16] = c - q;
       }
@@ -113,15 +113,21 @@ void FastDetector::scan(int threshold, int x0, int y0, int x1, int y1) {
         score = cv::v_max(score, cv::v_min(cv::v_min(b4a, b4b), b[k + 8]));
         score = cv::v_max(score, cv::v_min(cv::v_min(e4a, e4b), e[k + 8]));
       }
-      int mask = cv::v_signmask((score > t) & maybe);
-      if (!mask) continue;
+      int mask = cv::v_signmask((score > t) & maybe) & (0xFFFF << first_lane);
+      if (!mask) return;
       uint8_t lane_score[16];
       cv::v_store(lane_score, score);
       while (mask) {
         const int lane = __builtin_ctz(mask);
         mask &= mask - 1;
-        record(score_row, x + lane, y, lane_score[lane]);
+        record(score_row, bx + lane, y, lane_score[lane]);
       }
+    };
+    int x = x0;
+    for (; x + 16 <= x_end; x += 16) block(x, 0);
+    if (x < x_end && x_end - x0 >= 16) {
+      block(x_end - 16, 16 - (x_end - x));  // overlapping last block, only its new lanes
+      x = x_end;
     }
     for (; x < x_end; ++x) record(score_row, x, y, fastScore(row + x, stride));  // tail
   }

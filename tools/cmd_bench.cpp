@@ -50,6 +50,7 @@ struct Series {
 void printUsage() {
   std::printf(
       "usage: plumb bench frontend --dataset DIR [--camera tum1] [--frames N] [--no-stock]\n"
+      "                            [--line-level L] [--line-samples N] [--opencv-lsd]\n"
       "  Runs the front end (pipeline/feature_extractor.h) with default ExtractorOptions on every\n"
       "  frame of a TUM-layout folder, single thread, then the stock OpenCV path on the same frame.\n");
 }
@@ -81,7 +82,7 @@ struct StockPath {
 };
 
 int benchFrontend(int argc, char** argv) {
-  Args args(argc, argv, {"dataset", "camera", "frames"}, {"no-stock"});
+  Args args(argc, argv, {"dataset", "camera", "frames", "line-level", "line-samples"}, {"no-stock", "opencv-lsd"});
   if (args.help()) { printUsage(); return 0; }
   if (!args.error().empty() || !args.has("dataset")) {
     std::fprintf(stderr, "plumb bench frontend: %s\n", args.error().empty() ? "--dataset is required" : args.error().c_str());
@@ -98,13 +99,23 @@ int benchFrontend(int argc, char** argv) {
   if (!st.ok()) { std::fprintf(stderr, "plumb bench frontend: %s\n", st.message().c_str()); return 1; }
 
   cv::setNumThreads(1);  // single thread, for both paths
-  const ExtractorOptions options;
+  ExtractorOptions options;
+  options.line_level = static_cast<int>(args.getInt("line-level", options.line_level, &ok));
+  options.line_samples = static_cast<int>(args.getInt("line-samples", options.line_samples, &ok));
+  options.use_opencv_lsd = args.has("opencv-lsd");
+  if (!ok || options.line_samples < 0 || options.line_samples > static_cast<int>(kMaxLineSamples) ||
+      options.line_level < 0 || options.line_level >= options.num_levels) {
+    std::fprintf(stderr, "plumb bench frontend: --line-level must be 0..%d, --line-samples 0..%zu\n",
+                 options.num_levels - 1, kMaxLineSamples);
+    return 2;
+  }
   FeatureExtractor extractor(camera, options);
   auto features = std::make_unique<FrameFeatures>();
   StockPath stock;
   const bool run_stock = !args.has("no-stock");
 
   Series orb{"ORB", {}}, lines{"lines + LBD", {}}, depth{"depth + sampling", {}}, total{"frontend total", {}};
+  Series cpu_orb{"ORB (CPU)", {}}, cpu_lines{"lines + LBD (CPU)", {}}, cpu_depth{"depth + sampling (CPU)", {}};
   Series cpu_total{"frontend total (CPU)", {}}, s_cpu_total{"stock total (CPU)", {}};
   Series s_orb{"stock cv::ORB", {}}, s_lsd{"stock LSDDetector", {}}, s_lbd{"stock BinaryDescriptor", {}},
       s_total{"stock total", {}};
@@ -124,6 +135,9 @@ int benchFrontend(int argc, char** argv) {
     depth.ms.push_back(t.depth_ms);
     total.ms.push_back(t.total_ms);
     cpu_total.ms.push_back(t.total_cpu_ms);
+    cpu_orb.ms.push_back(t.orb_cpu_ms);
+    cpu_lines.ms.push_back(t.lines_cpu_ms);
+    cpu_depth.ms.push_back(t.depth_cpu_ms);
     sum_kp += t.num_keypoints;
     sum_kp_depth += t.num_keypoints_with_depth;
     sum_lines += t.num_lines;
@@ -148,6 +162,9 @@ int benchFrontend(int argc, char** argv) {
   lines.print();
   depth.print();
   total.print();
+  cpu_orb.print();
+  cpu_lines.print();
+  cpu_depth.print();
   cpu_total.print();
   if (run_stock) {
     std::printf("  stock path: %.0f lines described per frame\n", sum_stock_lines / frames);

@@ -1,9 +1,9 @@
 // Steady-state allocation contract of the front end: extraction allocates nothing of its own.
-// The only allocations are inside two OpenCV calls (documented in docs/FRONTEND.md): cv::resize
-// while building the pyramid (2 small buffers per level) and cv::LineSegmentDetector::detect. So
-// extract() must allocate exactly what ImagePyramid::build plus a bare LSD call on the same level
-// allocate -- with lines off (points only), exactly what the pyramid allocates. Matching allocates
-// nothing.
+// The only allocations are inside OpenCV calls (documented in docs/FRONTEND.md): cv::resize while
+// building the pyramid (2-3 small buffers per level) and, only when use_opencv_lsd is chosen,
+// cv::LineSegmentDetector::detect. So with the default options extract() must allocate exactly
+// what ImagePyramid::build allocates, and with OpenCV's LSD exactly that plus what a bare LSD call
+// on the same level allocates. Matching allocates nothing.
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
@@ -16,12 +16,11 @@
 namespace plumb {
 namespace {
 
-TEST(FrontendAllocations, PointsOnlyExtractionAndMatchingAllocateNothing) {
+TEST(FrontendAllocations, ExtractionAllocatesOnlyInsideCvResizeAndMatchingNothing) {
   auto scene = test::makeScene("textured", 31);
   ASSERT_TRUE(scene);
   const RgbdImage a = test::renderFrame(*scene, 0), b = test::renderFrame(*scene, 3);
-  ExtractorOptions options;
-  options.max_lines = 0;
+  const ExtractorOptions options;  // points and lines, our line detector
   FeatureExtractor extractor(scene->camera(), options);
   auto fa = std::make_unique<FrameFeatures>(), fb = std::make_unique<FrameFeatures>();
   ASSERT_TRUE(extractor.extract(a, *fa));  // warm-up (OpenCV lazily initialises its globals)
@@ -50,13 +49,15 @@ TEST(FrontendAllocations, PointsOnlyExtractionAndMatchingAllocateNothing) {
   EXPECT_EQ(extract_allocations, pyramid_allocations);
   EXPECT_GT(n, 100);
   EXPECT_GT(fa->keypoints.size(), 500u);
+  EXPECT_GT(fa->lines.size(), 50u);
 }
 
-TEST(FrontendAllocations, WithLinesOnlyTheLineSegmentDetectorAllocates) {
+TEST(FrontendAllocations, WithOpenCvLsdOnlyResizeAndTheLsdAllocate) {
   auto scene = test::makeScene("textured", 32);
   ASSERT_TRUE(scene);
   const RgbdImage frame = test::renderFrame(*scene, 7);
-  const ExtractorOptions options;
+  ExtractorOptions options;
+  options.use_opencv_lsd = true;
   FeatureExtractor extractor(scene->camera(), options);
   auto features = std::make_unique<FrameFeatures>();
   ASSERT_TRUE(extractor.extract(frame, *features));

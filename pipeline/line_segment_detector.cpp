@@ -1,0 +1,171 @@
+#include "pipeline/line_segment_detector.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace plumb {
+namespace {
+
+constexpr int kBins = 1024;
+constexpr uint8_t kFree = 0, kUsed = 1;
+
+}  // namespace
+
+LineSegmentDetector::LineSegmentDetector(int max_width, int max_height, const LineSegmentDetectorOptions& options)
+    : options_(options), max_width_(max_width), max_height_(max_height) {
+  const size_t n = static_cast<size_t>(max_width) * max_height;
+  magnitude_.resize(n);
+  dir_x_.resize(n);
+  dir_y_.resize(n);
+  state_.resize(n);
+  bucket_start_.resize(kBins + 1);
+  ordered_.resize(n);
+  region_.resize(n);
+}
+
+int LineSegmentDetector::detect(const cv::Mat& image, float min_length, DetectedSegment* out, int capacity) {
+  CV_Assert(image.type() == CV_8UC1 && image.cols <= max_width_ && image.rows <= max_height_);
+  width_ = image.cols;
+  height_ = image.rows;
+  const int w = width_, h = height_;
+  const float tau = options_.angle_tolerance_deg * static_cast<float>(M_PI) / 180.f;
+  const float threshold = options_.quantization / std::sin(tau);
+  const float cos_tau = std::cos(tau);
+
+  // 2x2 gradient at (x + 0.5, y + 0.5); the last row and column have none.
+  float max_magnitude = 0;
+  for (int y = 0; y < h; ++y) {
+    float* mag = magnitude_.data() + y * w;
+    float* ux = dir_x_.data() + y * w;
+    float* uy = dir_y_.data() + y * w;
+    uint8_t* st = state_.data() + y * w;
+    if (y == h - 1) {
+      std::fill_n(mag, w, 0.f);
+      std::fill_n(st, w, kUsed);
+      break;
+    }
+    const uint8_t* r0 = image.ptr<uint8_t>(y);
+    const uint8_t* r1 = image.ptr<uint8_t>(y + 1);
+    for (int x = 0; x < w - 1; ++x) {
+      const int a = r0[x], b = r0[x + 1], c = r1[x], d = r1[x + 1];
+      const float gx = 0.5f * static_cast<float>(b + d - a - c);
+      const float gy = 0.5f * static_cast<float>(c + d - a - b);
+      const float m = std::sqrt(gx * gx + gy * gy);
+      mag[x] = m;
+      const float inv = m > 0 ? 1.f / m : 0.f;
+      ux[x] = gx * inv;
+      uy[x] = gy * inv;
+      st[x] = m > threshold ? kFree : kUsed;
+      max_magnitude = std::max(max_magnitude, m);
+    }
+    mag[w - 1] = 0;
+    st[w - 1] = kUsed;
+  }
+  if (max_magnitude <= threshold) return 0;
+
+  // Bucket sort of candidate pixels by magnitude, strongest bucket first.
+  const float bin_scale = (kBins - 1) / max_magnitude;
+  std::fill(bucket_start_.begin(), bucket_start_.end(), 0);
+  const int n = w * h;
+  for (int i = 0; i < n; ++i) {
+    if (state_[i] == kFree) ++bucket_start_[kBins - 1 - static_cast<int>(magnitude_[i] * bin_scale) + 1];
+  }
+  for (int b = 0; b < kBins; ++b) bucket_start_[b + 1] += bucket_start_[b];
+  const int candidates = bucket_start_[kBins];
+  for (int i = 0; i < n; ++i) {
+    if (state_[i] == kFree) ordered_[bucket_start_[kBins - 1 - static_cast<int>(magnitude_[i] * bin_scale)]++] = i;
+  }
+
+  int count = 0;
+  for (int k = 0; k < candidates && count < capacity; ++k) {
+    const int seed = ordered_[k];
+    if (state_[seed] != kFree) continue;
+    // Grow the region; its direction is the running (unnormalised) sum of unit gradients.
+    state_[seed] = kUsed;
+    region_[0] = seed;
+    int size = 1;
+    float sum_x = dir_x_[seed], sum_y = dir_y_[seed];
+    for (int r = 0; r < size; ++r) {
+      const int p = region_[r];
+      const int px = p % w, py = p / w;
+      for (int dy = -1; dy <= 1; ++dy) {
+        const int qy = py + dy;
+        if (qy < 0 || qy >= h) continue;
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int qx = px + dx;
+          if (qx < 0 || qx >= w) continue;
+          const int q = qy * w + qx;
+          if (state_[q] != kFree) continue;
+          const float norm = std::sqrt(sum_x * sum_x + sum_y * sum_y);
+          if (dir_x_[q] * sum_x + dir_y_[q] * sum_y < cos_tau * norm) continue;
+          state_[q] = kUsed;
+          region_[size++] = q;
+          sum_x += dir_x_[q];
+          sum_y += dir_y_[q];
+        }
+      }
+    }
+    if (size < 4) continue;
+    if (regionToSegment(size, min_length, &out[count])) ++count;
+  }
+  return count;
+}
+
+bool LineSegmentDetector::regionToSegment(int size, float min_length, DetectedSegment* segment) const {
+  const int w = width_;
+  double sw = 0, cx = 0, cy = 0, gx = 0, gy = 0;
+  for (int i = 0; i < size; ++i) {
+    const int p = region_[i];
+    const double m = magnitude_[p];
+    sw += m;
+    cx += m * (p % w);
+    cy += m * (p / w);
+    gx += m * dir_x_[p];
+    gy += m * dir_y_[p];
+  }
+  cx /= sw;
+  cy /= sw;
+  double sxx = 0, syy = 0, sxy = 0;
+  for (int i = 0; i < size; ++i) {
+    const int p = region_[i];
+    const double m = magnitude_[p], dx = (p % w) - cx, dy = (p / w) - cy;
+    sxx += m * dx * dx;
+    syy += m * dy * dy;
+    sxy += m * dx * dy;
+  }
+  // Principal axis of the weighted scatter = the segment direction.
+  const double theta = 0.5 * std::atan2(2 * sxy, sxx - syy);
+  double ux = std::cos(theta), uy = std::sin(theta);
+  // Convention: the mean gradient points to the left of the direction (y down): flip if needed.
+  if (ux * gy - uy * gx > 0) {
+    ux = -ux;
+    uy = -uy;
+  }
+  double l_min = 1e30, l_max = -1e30, across2 = 0;
+  for (int i = 0; i < size; ++i) {
+    const int p = region_[i];
+    const double dx = (p % w) - cx, dy = (p / w) - cy;
+    const double along = dx * ux + dy * uy, across = -dx * uy + dy * ux;
+    l_min = std::min(l_min, along);
+    l_max = std::max(l_max, along);
+    across2 += magnitude_[p] * across * across;
+  }
+  const double across_rms = std::sqrt(across2 / sw);
+  const double length = l_max - l_min + 1;
+  // Straight and thin: the weighted RMS distance across the axis (curved or blob-like regions
+  // spread out) and the mean thickness (region pixels per unit length).
+  if (length < min_length || across_rms > options_.max_rms_width_px || size > options_.max_thickness_px * length) {
+    return false;
+  }
+  // The 2x2 gradient of pixel (x, y) sits at (x + 0.5, y + 0.5).
+  const double ox = cx + 0.5, oy = cy + 0.5;
+  segment->x0 = static_cast<float>(ox + l_min * ux);
+  segment->y0 = static_cast<float>(oy + l_min * uy);
+  segment->x1 = static_cast<float>(ox + l_max * ux);
+  segment->y1 = static_cast<float>(oy + l_max * uy);
+  segment->length = static_cast<float>(l_max - l_min);
+  segment->mean_gradient = static_cast<float>(sw / size);
+  return true;
+}
+
+}  // namespace plumb
