@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 
@@ -170,11 +171,19 @@ void drawErrorsOverTime(cv::Mat& image, Panel panel, const AteResult& ate) {
   }
 }
 
+bool hasPngExtension(const std::string& path) {
+  if (path.size() < 4) return false;
+  std::string extension = path.substr(path.size() - 4);
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return extension == ".png";
+}
+
 }  // namespace
 
 Status writeTrajectoryPlot(const std::string& png_path, const AteResult& ate,
                            const TrajectoryPlotOptions& options) {
   if (ate.samples.empty()) return Status::Error(png_path + ": nothing to plot (no ATE samples)");
+  if (!hasPngExtension(png_path)) return Status::Error(png_path + ": plot file name must end in .png");
   if (options.width_px < 300 || options.height_px < 400)
     return Status::Error(png_path + ": plot size too small (minimum 300x400)");
   cv::Mat image(options.height_px, options.width_px, CV_8UC3, kWhite);
@@ -196,9 +205,9 @@ Status writeTrajectoryPlot(const std::string& png_path, const AteResult& ate,
   try {
     written = cv::imwrite(png_path, image);
   } catch (const cv::Exception& e) {
-    return Status::Error(png_path + ": cannot write plot (" + e.what() + ")");
+    return Status::Error(png_path + ": cannot write plot (" + e.err + ")");
   }
-  if (!written) return Status::Error(png_path + ": cannot write plot");
+  if (!written) return Status::Error(png_path + ": cannot write plot (missing folder or no permission?)");
   return Status::Ok();
 }
 

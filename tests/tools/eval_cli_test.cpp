@@ -121,6 +121,18 @@ TEST(EvalCli, UnrelatedTrajectoriesAreAnErrorNotANumber) {
   EXPECT_EQ(r.output.find("ATE RMSE"), std::string::npos) << r.output;
 }
 
+TEST(EvalCli, UnwritablePlotIsAnErrorNamingThePath) {
+  ScratchDir dir;
+  std::string poses;
+  for (int i = 0; i < 40; ++i) poses += std::to_string(1.0 + 0.1 * i) + " " + std::to_string(0.01 * i) + " 0 0 0 0 0 1\n";
+  const std::string gt = dir.write("gt.txt", poses);
+  for (const std::string& plot : {dir.file("no_such_folder/plot.png"), dir.file("plot.jpgx")}) {
+    const RunResult r = runPlumb("eval --gt " + gt + " --est " + gt + " --plot " + plot);
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_NE(r.output.find(plot), std::string::npos) << r.output;
+  }
+}
+
 TEST(EvalCli, UsageErrorsExitWithTwo) {
   EXPECT_EQ(runPlumb("eval").exit_code, 2);
   EXPECT_EQ(runPlumb("eval --gt a.txt").exit_code, 2);
