@@ -1,4 +1,5 @@
 #include "runtime/stage_runner.h"
+#include "runtime/function_stage.h"
 
 #include <gtest/gtest.h>
 
@@ -121,6 +122,29 @@ TEST(StageRunner, TooManyStagesIsAClearError) {
   const Status status = runner.run();
   EXPECT_FALSE(status.ok());
   EXPECT_NE(status.message().find("at most"), std::string::npos);
+}
+
+TEST(FunctionStage, ACallableIsAStageInEveryMode) {
+  for (RunMode mode : {RunMode::kDeterministic, RunMode::kFast}) {
+    ToySource source(50, kPeriodNs);
+    uint64_t sum = 0;  // written only by the stage's thread, read after run()
+    auto double_it = makeFunctionStage<ToyFrame>("double", [](ToyFrame& f, const FrameStamps&) {
+      f.value *= 2;
+      return Status::Ok();
+    });
+    auto add_up = makeFunctionStage<ToyFrame>("sum", [&sum](ToyFrame& f, const FrameStamps&) {
+      sum += f.value;
+      return Status::Ok();
+    });
+    RunOptions options;
+    options.mode = mode;
+    StageRunner<ToyFrame> runner(source, {&double_it, &add_up}, options);
+    ASSERT_TRUE(runner.run().ok());
+    uint64_t expected = 0;
+    for (uint64_t n = 0; n < 50; ++n) expected += 2 * (n * 0x9E3779B97F4A7C15ull + 1);
+    EXPECT_EQ(sum, expected) << runModeName(mode);
+    EXPECT_EQ(runner.report().stages[1].name, "double");
+  }
 }
 
 }  // namespace
