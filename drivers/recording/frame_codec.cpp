@@ -10,7 +10,8 @@ namespace {
 bool encodePng(const cv::Mat& image, int png_compression, std::vector<uint8_t>& out) {
   // imencode fills its own vector; it is kept across calls so its capacity is reused.
   thread_local std::vector<uint8_t> encoded;
-  const std::vector<int> params = {cv::IMWRITE_PNG_COMPRESSION, png_compression};
+  thread_local std::vector<int> params = {cv::IMWRITE_PNG_COMPRESSION, 1};
+  params[1] = png_compression;
   if (!cv::imencode(".png", image, encoded, params)) return false;
   out.insert(out.end(), encoded.begin(), encoded.end());
   return true;

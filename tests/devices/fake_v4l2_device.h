@@ -45,11 +45,12 @@ class FakeV4l2Device : public V4l2Device {
  public:
   std::map<std::string, FakeV4l2Node> nodes;
   std::vector<std::string> log;
+  bool logging = true;  // off for allocation tests (the log itself allocates)
   int live_mappings = 0;
   int open_fds = 0;
 
   int open(const char* path, int) override {
-    log.push_back(std::string("open ") + path);
+    note(std::string("open ") + path);
     auto it = nodes.find(path);
     if (it == nodes.end()) return fail(ENOENT);
     if (it->second.unplugged) return fail(ENODEV);
@@ -59,13 +60,13 @@ class FakeV4l2Device : public V4l2Device {
     return fd;
   }
   int close(int fd) override {
-    log.push_back("close");
+    note("close");
     if (!fds_.erase(fd)) return fail(EBADF);
     --open_fds;
     return 0;
   }
   void* mmap(std::size_t length, int fd, off_t offset) override {
-    log.push_back("mmap");
+    note("mmap");
     FakeV4l2Node* n = node(fd);
     const std::size_t index = static_cast<std::size_t>(offset) / kPage;
     if (!n || index >= n->buffers.size() || length != n->buffers[index].size()) {
@@ -76,19 +77,19 @@ class FakeV4l2Device : public V4l2Device {
     return n->buffers[index].data();
   }
   int munmap(void*, std::size_t) override {
-    log.push_back("munmap");
+    note("munmap");
     --live_mappings;
     return 0;
   }
   int poll(int fd, int) override {
-    log.push_back("poll");
+    note("poll");
     FakeV4l2Node* n = node(fd);
     if (!n) return fail(EBADF);
     return n->queued.empty() ? 0 : 1;
   }
 
   int ioctl(int fd, unsigned long request, void* arg) override {
-    log.push_back(v4l2RequestName(request));
+    note(v4l2RequestName(request));
     FakeV4l2Node* n = node(fd);
     if (!n) return fail(EBADF);
     if (request == n->failing_request) return fail(n->failing_errno);
@@ -154,6 +155,13 @@ class FakeV4l2Device : public V4l2Device {
       }
       default: return fail(ENOTTY);
     }
+  }
+
+  void note(const std::string& entry) {
+    if (logging) log.push_back(entry);
+  }
+  void note(const char* entry) {
+    if (logging) log.push_back(entry);
   }
 
   // Number of log entries equal to `entry`.
