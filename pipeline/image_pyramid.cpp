@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace plumb {
@@ -16,7 +17,7 @@ ImagePyramid::ImagePyramid(int width, int height, int num_levels, float scale_fa
                         static_cast<int>(std::lround(height / scales_[i])));
     total_rows += sizes[i].height;
   }
-  row_filtered_.create(height, width, CV_16UC1);
+  row_filtered_.create(1, width + 6, CV_16UC1);  // one padded row
   const cv::Mat kernel = cv::getGaussianKernel(7, 2.0, CV_64F);
   int sum = 0;
   for (int k = 0; k < 7; ++k) sum += kernel_[k] = static_cast<int>(std::lround(kernel.at<double>(k) * 256));
@@ -46,35 +47,52 @@ void ImagePyramid::build(const cv::Mat& grey) {
 }
 
 void ImagePyramid::blur(const cv::Mat& src, cv::Mat& dst) {
+  // Separable, vertical pass first, 8.8 fixed point: the vertical sum (<= 255 * 256) is rounded
+  // back to 8 bits of range so the horizontal pass also fits 16-bit lanes (the lost fraction is far
+  // below what the binary tests can see). One padded 16-bit row buffer, reflected borders.
   const int w = src.cols, h = src.rows;
-  const int k0 = kernel_[0], k1 = kernel_[1], k2 = kernel_[2], k3 = kernel_[3];  // symmetric
   auto reflect = [](int i, int n) { return i < 0 ? -i : (i >= n ? 2 * n - 2 - i : i); };  // REFLECT_101
+  uint16_t* t = row_filtered_.ptr<uint16_t>(0) + 3;  // t[-3 .. w+2] valid after padding
+  const uint16_t k[7] = {uint16_t(kernel_[0]), uint16_t(kernel_[1]), uint16_t(kernel_[2]), uint16_t(kernel_[3]),
+                         uint16_t(kernel_[4]), uint16_t(kernel_[5]), uint16_t(kernel_[6])};
+  cv::v_uint16x8 vk[7];
+  for (int i = 0; i < 7; ++i) vk[i] = cv::v_setall_u16(k[i]);
+  const cv::v_uint16x8 half = cv::v_setall_u16(128);
   for (int y = 0; y < h; ++y) {
-    const uint8_t* s = src.ptr<uint8_t>(y);
-    uint16_t* t = row_filtered_.ptr<uint16_t>(y);
-    for (int x = 0; x < 3; ++x) {
-      int acc = 0;
-      for (int k = -3; k <= 3; ++k) acc += kernel_[k + 3] * s[reflect(x + k, w)];
-      t[x] = static_cast<uint16_t>(acc);
+    const uint8_t* r[7];
+    for (int i = 0; i < 7; ++i) r[i] = src.ptr<uint8_t>(reflect(y + i - 3, h));
+    int x = 0;
+    for (; x + 16 <= w; x += 16) {
+      cv::v_uint16x8 lo = cv::v_setzero_u16(), hi = cv::v_setzero_u16();
+      for (int i = 0; i < 7; ++i) {
+        cv::v_uint16x8 a, b;
+        cv::v_expand(cv::v_load(r[i] + x), a, b);
+        lo += cv::v_mul_wrap(a, vk[i]);  // the sum stays <= 65280: no overflow
+        hi += cv::v_mul_wrap(b, vk[i]);
+      }
+      cv::v_store(t + x, (lo + half) >> 8);
+      cv::v_store(t + x + 8, (hi + half) >> 8);
     }
-    for (int x = 3; x < w - 3; ++x) {  // interior: plain loop the compiler vectorises
-      t[x] = static_cast<uint16_t>(k0 * (s[x - 3] + s[x + 3]) + k1 * (s[x - 2] + s[x + 2]) +
-                                   k2 * (s[x - 1] + s[x + 1]) + k3 * s[x]);
+    for (; x < w; ++x) {
+      unsigned acc = 0;
+      for (int i = 0; i < 7; ++i) acc += k[i] * r[i][x];
+      t[x] = static_cast<uint16_t>((acc + 128) >> 8);
     }
-    for (int x = std::max(3, w - 3); x < w; ++x) {
-      int acc = 0;
-      for (int k = -3; k <= 3; ++k) acc += kernel_[k + 3] * s[reflect(x + k, w)];
-      t[x] = static_cast<uint16_t>(acc);
+    for (int i = 1; i <= 3; ++i) {
+      t[-i] = t[reflect(-i, w)];
+      t[w - 1 + i] = t[reflect(w - 1 + i, w)];
     }
-  }
-  for (int y = 0; y < h; ++y) {
-    const uint16_t* r[7];
-    for (int k = -3; k <= 3; ++k) r[k + 3] = row_filtered_.ptr<uint16_t>(reflect(y + k, h));
     uint8_t* d = dst.ptr<uint8_t>(y);
-    for (int x = 0; x < w; ++x) {
-      const uint32_t acc = k0 * (uint32_t(r[0][x]) + r[6][x]) + k1 * (uint32_t(r[1][x]) + r[5][x]) +
-                           k2 * (uint32_t(r[2][x]) + r[4][x]) + k3 * uint32_t(r[3][x]);
-      d[x] = static_cast<uint8_t>((acc + 32768) >> 16);
+    x = 0;
+    for (; x + 8 <= w; x += 8) {
+      cv::v_uint16x8 acc = cv::v_setzero_u16();
+      for (int i = 0; i < 7; ++i) acc += cv::v_mul_wrap(cv::v_load(t + x + i - 3), vk[i]);
+      cv::v_pack_store(d + x, (acc + half) >> 8);
+    }
+    for (; x < w; ++x) {
+      unsigned acc = 0;
+      for (int i = 0; i < 7; ++i) acc += k[i] * t[x + i - 3];
+      d[x] = static_cast<uint8_t>((acc + 128) >> 8);
     }
   }
 }

@@ -36,7 +36,7 @@ class ImagePyramid {
   void blur(const cv::Mat& src, cv::Mat& dst);
 
   cv::Mat buffer_, blurred_buffer_;
-  cv::Mat row_filtered_;            // CV_16UC1 level-0 size: horizontal pass of the blur
+  cv::Mat row_filtered_;            // CV_16UC1, one row + 3 px padding each side: the blur's vertical pass
   std::array<int, 7> kernel_{};     // 7-tap Gaussian, sigma 2, fixed point (sum 256)
   std::array<cv::Mat, kPyramidLevels> levels_, blurred_levels_;
 };
