@@ -79,6 +79,18 @@ TEST(CameraModel, UndistortInvertsDistortOverTheWholeImageTum1AndTum2) {
       }
     }
     EXPECT_LT(worst_px, 1e-3) << preset;
+    // And the other way: an ideal pixel whose distorted image lies in the image (where keypoints
+    // can come from), distorted, undistorts back to itself.
+    worst_px = 0;
+    for (int v = 0; v < camera.height; v += 8) {
+      for (int u = 0; u < camera.width; u += 8) {
+        const Eigen::Vector2d distorted = camera.distortPoint(u, v);
+        if (!camera.inImage(distorted.x(), distorted.y())) continue;
+        const Eigen::Vector2d back = camera.undistortPoint(distorted.x(), distorted.y());
+        worst_px = std::max(worst_px, (back - Eigen::Vector2d(u, v)).norm());
+      }
+    }
+    EXPECT_LT(worst_px, 1e-3) << preset;
     // The corners really are moved (the test would pass trivially with no distortion).
     EXPECT_GT((camera.undistortPoint(0, 0) - Eigen::Vector2d(0, 0)).norm(), 1.0) << preset;
   }
