@@ -22,15 +22,55 @@ namespace plumb {
 // Points closer than this to the camera plane [m] are rejected by the factors.
 constexpr double kFactorMinDepth = 1e-6;
 
-// d[u, v, u_r] / d P_cam at P_cam (Z > 0). Row 2 is the virtual right camera.
-inline Eigen::Matrix3d stereoProjectionJacobian(const CameraIntrinsics& camera,
-                                                const Eigen::Vector3d& P_cam) {
+// ---- Camera-frame residuals: e and d e / d P_cam at P_cam (caller checks Z > kFactorMinDepth).
+// The optimisers use these directly (pose-only works in point space, see pose_optimizer.cpp).
+
+inline void stereoResidualAt(const CameraIntrinsics& camera, const Eigen::Vector3d& P_cam,
+                             const Eigen::Vector3d& z_uvr, Eigen::Vector3d* e, Eigen::Matrix3d* J_cam) {
   const double inv_z = 1.0 / P_cam.z();
-  const double inv_z2 = inv_z * inv_z;
-  Eigen::Matrix3d J;
-  J << camera.fx * inv_z, 0.0, -camera.fx * P_cam.x() * inv_z2,  //
-      0.0, camera.fy * inv_z, -camera.fy * P_cam.y() * inv_z2,   //
-      camera.fx * inv_z, 0.0, (-camera.fx * P_cam.x() + camera.bf) * inv_z2;
+  const double u = camera.fx * P_cam.x() * inv_z + camera.cx;
+  const double v = camera.fy * P_cam.y() * inv_z + camera.cy;
+  *e = Eigen::Vector3d(u - z_uvr.x(), v - z_uvr.y(), u - camera.bf * inv_z - z_uvr.z());
+  if (J_cam == nullptr) return;
+  const double fx_z = camera.fx * inv_z;
+  const double fy_z = camera.fy * inv_z;
+  const double du_dz = -fx_z * P_cam.x() * inv_z;
+  *J_cam << fx_z, 0.0, du_dz,                    //
+      0.0, fy_z, -fy_z * P_cam.y() * inv_z,      //
+      fx_z, 0.0, du_dz + camera.bf * inv_z * inv_z;
+}
+
+inline void monoResidualAt(const CameraIntrinsics& camera, const Eigen::Vector3d& P_cam,
+                           const Eigen::Vector2d& z_uv, Eigen::Vector2d* e, Matrix23d* J_cam) {
+  const double inv_z = 1.0 / P_cam.z();
+  const double fx_z = camera.fx * inv_z;
+  const double fy_z = camera.fy * inv_z;
+  *e = Eigen::Vector2d(fx_z * P_cam.x() + camera.cx - z_uv.x(), fy_z * P_cam.y() + camera.cy - z_uv.y());
+  if (J_cam == nullptr) return;
+  *J_cam << fx_z, 0.0, -fx_z * P_cam.x() * inv_z,  //
+      0.0, fy_z, -fy_z * P_cam.y() * inv_z;
+}
+
+inline void lineResidualAt(const CameraIntrinsics& camera, const Eigen::Vector3d& P_cam,
+                           const Eigen::Vector3d& line, double* e, Eigen::RowVector3d* J_cam) {
+  const double inv_z = 1.0 / P_cam.z();
+  const double a_fx_z = line.x() * camera.fx * inv_z;  // d e / d X
+  const double b_fy_z = line.y() * camera.fy * inv_z;  // d e / d Y
+  *e = a_fx_z * P_cam.x() + b_fy_z * P_cam.y() + line.x() * camera.cx + line.y() * camera.cy + line.z();
+  if (J_cam == nullptr) return;
+  *J_cam << a_fx_z, b_fy_z, -(a_fx_z * P_cam.x() + b_fy_z * P_cam.y()) * inv_z;
+}
+
+// d e / d delta = J_cam [ I | -[P_cam]x ]. Row r of J_cam [P_cam]x is (r x P_cam)^T, so the
+// rotation block is (P_cam x r)^T: three cross products instead of a 3x3 product.
+template <int R>
+inline Eigen::Matrix<double, R, 6> liftToPose(const Eigen::Matrix<double, R, 3>& J_cam, const Eigen::Vector3d& P_cam) {
+  Eigen::Matrix<double, R, 6> J;
+  J.template leftCols<3>() = J_cam;
+  for (int r = 0; r < R; ++r) {
+    const Eigen::Vector3d row = J_cam.row(r).transpose();
+    J.template block<1, 3>(r, 3) = P_cam.cross(row).transpose();
+  }
   return J;
 }
 
@@ -49,19 +89,19 @@ inline Matrix36d pointPoseJacobian(const Eigen::Vector3d& P_cam) {
   return J;
 }
 
+// ---- World-frame factors: residual and Jacobians wrt the pose (6) and the world point (3).
+
 // Stereo (RGB-D) point: residual [u, v, u_r] - z_uvr.
 inline bool evaluateStereoPoint(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_cam_world,
                                 const Eigen::Vector3d& P_world, const Eigen::Vector3d& z_uvr,
                                 Eigen::Vector3d* residual, Matrix36d* J_pose, Eigen::Matrix3d* J_point) {
   const Eigen::Vector3d P_cam = T_cam_world * P_world;
   if (!(P_cam.z() > kFactorMinDepth)) return false;
-  const Eigen::Vector2d uv = projectToPixel(camera, P_cam);
-  *residual = Eigen::Vector3d(uv.x(), uv.y(), uv.x() - camera.bf / P_cam.z()) - z_uvr;
-  if (J_pose != nullptr || J_point != nullptr) {
-    const Eigen::Matrix3d J_proj = stereoProjectionJacobian(camera, P_cam);
-    if (J_pose != nullptr) *J_pose = J_proj * pointPoseJacobian(P_cam);
-    if (J_point != nullptr) J_point->noalias() = J_proj * T_cam_world.linear();
-  }
+  const bool want_jacobians = J_pose != nullptr || J_point != nullptr;
+  Eigen::Matrix3d J_cam;
+  stereoResidualAt(camera, P_cam, z_uvr, residual, want_jacobians ? &J_cam : nullptr);
+  if (J_pose != nullptr) *J_pose = liftToPose<3>(J_cam, P_cam);
+  if (J_point != nullptr) J_point->noalias() = J_cam * T_cam_world.linear();
   return true;
 }
 
@@ -71,12 +111,11 @@ inline bool evaluateMonoPoint(const CameraIntrinsics& camera, const Eigen::Isome
                               Eigen::Vector2d* residual, Matrix26d* J_pose, Matrix23d* J_point) {
   const Eigen::Vector3d P_cam = T_cam_world * P_world;
   if (!(P_cam.z() > kFactorMinDepth)) return false;
-  *residual = projectToPixel(camera, P_cam) - z_uv;
-  if (J_pose != nullptr || J_point != nullptr) {
-    const Matrix23d J_proj = stereoProjectionJacobian(camera, P_cam).topRows<2>();
-    if (J_pose != nullptr) *J_pose = J_proj * pointPoseJacobian(P_cam);
-    if (J_point != nullptr) J_point->noalias() = J_proj * T_cam_world.linear();
-  }
+  const bool want_jacobians = J_pose != nullptr || J_point != nullptr;
+  Matrix23d J_cam;
+  monoResidualAt(camera, P_cam, z_uv, residual, want_jacobians ? &J_cam : nullptr);
+  if (J_pose != nullptr) *J_pose = liftToPose<2>(J_cam, P_cam);
+  if (J_point != nullptr) J_point->noalias() = J_cam * T_cam_world.linear();
   return true;
 }
 
@@ -86,14 +125,11 @@ inline bool evaluateLineSample(const CameraIntrinsics& camera, const Eigen::Isom
                                double* residual, RowVector6d* J_pose, Eigen::RowVector3d* J_point) {
   const Eigen::Vector3d P_cam = T_cam_world * P_world;
   if (!(P_cam.z() > kFactorMinDepth)) return false;
-  const Eigen::Vector2d uv = projectToPixel(camera, P_cam);
-  *residual = line.x() * uv.x() + line.y() * uv.y() + line.z();
-  if (J_pose != nullptr || J_point != nullptr) {
-    const Eigen::RowVector3d J_proj =
-        line.head<2>().transpose() * stereoProjectionJacobian(camera, P_cam).topRows<2>();
-    if (J_pose != nullptr) *J_pose = J_proj * pointPoseJacobian(P_cam);
-    if (J_point != nullptr) *J_point = J_proj * T_cam_world.linear();
-  }
+  const bool want_jacobians = J_pose != nullptr || J_point != nullptr;
+  Eigen::RowVector3d J_cam;
+  lineResidualAt(camera, P_cam, line, residual, want_jacobians ? &J_cam : nullptr);
+  if (J_pose != nullptr) *J_pose = liftToPose<1>(J_cam, P_cam);
+  if (J_point != nullptr) J_point->noalias() = J_cam * T_cam_world.linear();
   return true;
 }
 

@@ -120,6 +120,7 @@ void LocalBundleAdjuster::reserve(int max_keyframes, int max_landmarks, int max_
   landmarks_.resize(std::max(max_landmarks, 0));
   observations_.resize(std::max(max_observations, 0));
   observation_order_.resize(observations_.size());
+  landmark_scratch_.resize(observations_.size());
   variable_keyframe_.resize(keyframes_.size());
   const Eigen::Index max_dim = 6 * static_cast<Eigen::Index>(keyframes_.size());
   S_.setZero(max_dim, max_dim);
@@ -330,24 +331,36 @@ bool LocalBundleAdjuster::solveDamped(const LocalBaOptions& options, double lamb
       ++num_fixed_landmarks_;
       continue;
     }
+    // Gather the observations in free keyframes (contiguous ids), forming V = W H_ll^-1 and the
+    // reduced right-hand side on the way.
     const int* order = &observation_order_[lm.first_observation];
+    int* free_obs = landmark_scratch_.data();
+    int num_free = 0;
     for (int a = 0; a < lm.num_observations; ++a) {
-      Observation& obs_a = observations_[order[a]];
-      const int v_a = keyframes_[obs_a.keyframe].variable;
-      if (!obs_a.valid || v_a < 0) continue;
-      obs_a.V.noalias() = obs_a.W * lm.H_point_inv;
-      rhs.segment<6>(6 * v_a).noalias() += obs_a.V * lm.g_point;
+      Observation& obs = observations_[order[a]];
+      const int v = keyframes_[obs.keyframe].variable;
+      if (!obs.valid || v < 0) continue;
+      obs.V.noalias() = obs.W * lm.H_point_inv;
+      rhs.segment<6>(6 * v).noalias() += obs.V * lm.g_point;
+      free_obs[num_free++] = order[a];
     }
-    // S_ab -= V_a W_b^T for every pair sharing this landmark, lower block triangle only.
-    for (int a = 0; a < lm.num_observations; ++a) {
-      const Observation& obs_a = observations_[order[a]];
+    // S_ab -= V_a W_b^T for every unordered pair sharing this landmark, written into the lower
+    // block triangle (row block >= column block), which is all the Cholesky reads.
+    for (int a = 0; a < num_free; ++a) {
+      const Observation& obs_a = observations_[free_obs[a]];
       const int v_a = keyframes_[obs_a.keyframe].variable;
-      if (!obs_a.valid || v_a < 0) continue;
-      for (int b = 0; b < lm.num_observations; ++b) {
-        const Observation& obs_b = observations_[order[b]];
+      S.block<6, 6>(6 * v_a, 6 * v_a).noalias() -= obs_a.V * obs_a.W.transpose();
+      for (int b = a + 1; b < num_free; ++b) {
+        const Observation& obs_b = observations_[free_obs[b]];
         const int v_b = keyframes_[obs_b.keyframe].variable;
-        if (!obs_b.valid || v_b < v_a) continue;
-        S.block<6, 6>(6 * v_b, 6 * v_a).noalias() -= obs_b.V * obs_a.W.transpose();
+        if (v_b > v_a) {
+          S.block<6, 6>(6 * v_b, 6 * v_a).noalias() -= obs_b.V * obs_a.W.transpose();
+        } else if (v_b < v_a) {
+          S.block<6, 6>(6 * v_a, 6 * v_b).noalias() -= obs_a.V * obs_b.W.transpose();
+        } else {  // two observations in one keyframe: both cross terms land on its diagonal block
+          S.block<6, 6>(6 * v_a, 6 * v_a).noalias() -= obs_a.V * obs_b.W.transpose();
+          S.block<6, 6>(6 * v_a, 6 * v_a).noalias() -= obs_b.V * obs_a.W.transpose();
+        }
       }
     }
   }

@@ -209,6 +209,7 @@ class LocalBundleAdjuster {
   std::vector<Landmark> landmarks_;
   std::vector<Observation> observations_;
   std::vector<int> observation_order_;  // observation indices grouped by landmark
+  std::vector<int> landmark_scratch_;   // one landmark's observations in free keyframes
   std::vector<int> variable_keyframe_;  // pose variable -> keyframe
   Eigen::MatrixXd S_;                   // reduced camera system / its Cholesky factor
   Eigen::VectorXd rhs_;                 // right-hand side / pose step of the reduced system

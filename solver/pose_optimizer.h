@@ -8,7 +8,8 @@
 // Gauss-Newton (or Levenberg-Marquardt) iterations; after each round EVERY observation is
 // re-classified by its chi-square value against the threshold of its dimension (3 dof stereo
 // points, 2 dof mono points, 1 dof line samples), so a wrongly rejected match can come back.
-// A round stops early once the step is below `step_tolerance`.
+// A round stops early once the step is below `step_tolerance`, and the rounds stop early once a
+// classification leaves every flag unchanged (the next round would repeat the last one).
 //
 // Covariance: at the solution, the inverse of H = sum_inliers J_i^T (w_i Omega_i) J_i (w_i the
 // IRLS weight rho'(s_i)), the 6x6 covariance of the left perturbation delta = [rho; phi] of
@@ -37,8 +38,9 @@ struct PoseOptimizerOptions {
   double chi2_line = 3.841;    // 1 dof
   int rounds = 4;                // ORB-SLAM2 uses 4 rounds ...
   int iterations_per_round = 10;  // ... of 10 iterations
-  // Stop a round when |delta| (translation in m and rotation in rad together) is below this.
-  double step_tolerance = 1e-8;
+  // Stop a round when |delta| (translation in m and rotation in rad together) is below this:
+  // 1e-6 (1 micrometre / microradian) is far below what RGB-D measurements can resolve.
+  double step_tolerance = 1e-6;
   // false: Gauss-Newton (steps always taken). true: Levenberg-Marquardt with lambda adapted to
   // the step quality (safer from poor initial poses, a little slower).
   bool levenberg_marquardt = false;

@@ -61,7 +61,34 @@ inline RobustKernelValue evaluateKernel(const RobustKernel& kernel, double s) {
   return out;
 }
 
-// The IRLS weight alone (rho'(s)), for the hot loops.
+// rho(s) and the IRLS weight rho'(s) only, for the hot loops: skips rho'' and one division.
+inline void robustCostAndWeight(const RobustKernel& kernel, double s, double* rho, double* weight) {
+  const double d2 = kernel.delta * kernel.delta;
+  switch (kernel.type) {
+    case RobustKernelType::kNone:
+      *rho = s;
+      *weight = 1.0;
+      return;
+    case RobustKernelType::kPseudoHuber: {
+      const double root = std::sqrt(1.0 + s / d2);
+      *rho = 2.0 * d2 * (root - 1.0);
+      *weight = 1.0 / root;
+      return;
+    }
+    case RobustKernelType::kHuber:
+      break;
+  }
+  if (s <= d2) {
+    *rho = s;
+    *weight = 1.0;
+  } else {
+    const double root = std::sqrt(s);
+    *rho = 2.0 * kernel.delta * root - d2;
+    *weight = kernel.delta / root;
+  }
+}
+
+// The IRLS weight alone (rho'(s)).
 inline double kernelWeight(const RobustKernel& kernel, double s) { return evaluateKernel(kernel, s).rho1; }
 
 }  // namespace plumb

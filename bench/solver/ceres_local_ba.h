@@ -8,7 +8,8 @@
 namespace plumb::bench {
 
 struct CeresRunResult {
-  double seconds = 0.0;  // wall time of ceres::Solve only
+  double seconds = 0.0;      // wall time of ceres::Solve only
+  double cpu_seconds = 0.0;  // CPU time of this thread in ceres::Solve (num_threads = 1)
   double final_cost = 0.0;
   double initial_cost = 0.0;
   int iterations = 0;
