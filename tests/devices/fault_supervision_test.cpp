@@ -76,6 +76,16 @@ TEST(FaultSupervision, CountsMatchWhatWasInjectedAndTheStreamContinues) {
   // Backoff 50, 100, 200 ms for the three failed attempts; the transient error needed no sleep.
   EXPECT_EQ(rig->clock.sleeps_ns, (std::vector<int64_t>{50'000'000, 100'000'000, 200'000'000}));
   EXPECT_EQ(stats.time_disconnected_ns, 350'000'000);
+  // What happened and when (virtual clock): the disconnect after frame 19 at t = 0, three
+  // failed reopens at 0, 50 and 150 ms, back at 350 ms, then the 4 lost frames seen as a gap.
+  std::vector<std::pair<SourceEventKind, int64_t>> timeline;
+  for (const SourceEvent& e : stats.events) timeline.emplace_back(e.kind, e.t_ns);
+  using K = SourceEventKind;
+  const std::vector<std::pair<SourceEventKind, int64_t>> expected_timeline = {
+      {K::kGap, 0},          {K::kError, 0},        {K::kReconnected, 0},   {K::kError, 0},
+      {K::kReopenFailed, 0}, {K::kReopenFailed, 50'000'000}, {K::kReopenFailed, 150'000'000},
+      {K::kReconnected, 350'000'000}, {K::kGap, 350'000'000}, {K::kGap, 350'000'000}};
+  EXPECT_EQ(timeline, expected_timeline);
   const std::string report = rig->supervised->describeEvents();
   EXPECT_NE(report.find("reconnected"), std::string::npos) << report;
   EXPECT_NE(report.find("frames missing (4)"), std::string::npos) << report;
