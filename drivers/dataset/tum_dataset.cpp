@@ -69,6 +69,14 @@ Status TumDatasetSource::open(const std::string& dir, const PinholeCamera& camer
     if (source->frames_.empty())
       return Status::Error(dir + ": no rgb.txt/depth.txt pair within 0.02 s of each other");
   }
+  // Fail fast: a missing image is reported at open, not minutes into a run.
+  const std::string lists = source->used_associations_file_ ? "associations.txt" : "rgb.txt/depth.txt";
+  for (const TumFrameEntry& frame : source->frames_) {
+    for (const std::string* relative : {&frame.rgb_path, &frame.depth_path}) {
+      if (!fileExists(dir + "/" + *relative))
+        return Status::Error(dir + "/" + *relative + ": missing image file (listed in " + lists + ")");
+    }
+  }
   *out = std::move(source);
   return Status::Ok();
 }

@@ -5,9 +5,10 @@
 // rgb.txt and depth.txt are paired with the benchmark's rule (greedy unique pairs by smallest
 // |dt|, |dt| < 0.02 s), see drivers/common/timestamp_association.h.
 //
-// Every list problem (missing/empty/unparsable list, non-monotonic or duplicate timestamps) is
-// reported by open(); image problems (missing, corrupt or truncated PNG, wrong size or bit depth)
-// by next()/load(). Messages name the file and, for lists, the line.
+// Every list problem (missing/empty/unparsable list, non-monotonic or duplicate timestamps) and
+// every listed image file that does not exist is reported by open(); image content problems
+// (corrupt or truncated PNG, wrong size or bit depth, a file gone since open) by next()/load().
+// Messages name the file and, for lists, the line.
 //
 // Buffers: PNGs are read into a reused byte buffer and decoded with cv::imdecode straight into the
 // caller's RgbdImage Mats. libpng decoding still allocates internally, so replay is not

@@ -91,9 +91,19 @@ TEST_F(BadDataset, TheValidFixtureLoads) {
   EXPECT_EQ(source->next(frame), SourceResult::kEndOfStream);
 }
 
-TEST_F(BadDataset, MissingImageFile) {
+TEST_F(BadDataset, MissingImageFileIsReportedAtOpen) {
+  std::filesystem::remove(file("depth/1.038000.png"));
+  std::unique_ptr<TumDatasetSource> source;
+  expectMentions(open(&source), file("depth/1.038000.png"), "missing image file (listed in rgb.txt/depth.txt)");
+}
+
+TEST_F(BadDataset, ImageFileRemovedAfterOpen) {
+  std::unique_ptr<TumDatasetSource> source;
+  ASSERT_TRUE(open(&source).ok());
   std::filesystem::remove(file("rgb/1.033333.png"));
-  expectMentions(loadFrame(1), file("rgb/1.033333.png"), "missing");
+  RgbdImage frame;
+  EXPECT_TRUE(source->load(0, frame).ok());
+  expectMentions(source->load(1, frame), file("rgb/1.033333.png"), "missing");
 }
 
 TEST_F(BadDataset, TruncatedPng) {

@@ -57,6 +57,7 @@ TEST(GarbageInput, PngCutAtEveryLengthFailsOrLoadsTheExactImage) {
   dir.write("seq/rgb.txt", "1.0 rgb/a.png\n");
   dir.write("seq/depth.txt", "1.0 depth/a.png\n");
   dir.write("seq/rgb/a.png", std::string(colour_png.begin(), colour_png.end()));
+  dir.write("seq/depth/a.png", std::string(depth_png.begin(), depth_png.end()));
   PinholeCamera camera;
   camera.fx = camera.fy = 10;
   camera.width = 8;
