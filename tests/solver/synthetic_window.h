@@ -20,8 +20,8 @@ struct SyntheticWindowConfig {
   unsigned seed = 1;
   int num_keyframes = 6;
   int num_fixed = 2;  // the first num_fixed keyframes are fixed
-  int num_points = 200;
-  int num_lines = 20;
+  int num_points = 200;  // point landmarks seen by >= 2 keyframes
+  int num_lines = 20;    // 3D segments seen by >= 2 keyframes, samples_per_line landmarks each
   int samples_per_line = 5;
   int views_per_landmark = 8;  // capped by the number of keyframes that see the landmark
   double mono_fraction = 0.2;  // point observations without depth
@@ -112,10 +112,13 @@ inline SyntheticWindow makeSyntheticWindow(const SyntheticWindowConfig& config) 
   const double sp = config.pixel_noise;
   std::vector<int> views;
 
-  for (int n = 0; n < config.num_points; ++n) {
+  // Draw until num_points points are seen by at least two keyframes (bounded number of draws).
+  int num_points = 0;
+  for (int draw = 0; num_points < config.num_points && draw < 50 * config.num_points; ++draw) {
     const Eigen::Vector3d P = randomScenePoint();
     pickViews(P, &views);
     if (views.size() < 2) continue;
+    ++num_points;
     const int lm = addLandmark(P, false);
     for (int i : views) {
       SyntheticObservation obs;
@@ -140,7 +143,8 @@ inline SyntheticWindow makeSyntheticWindow(const SyntheticWindowConfig& config) 
     }
   }
 
-  for (int n = 0; n < config.num_lines; ++n) {
+  int num_lines = 0;
+  for (int draw = 0; num_lines < config.num_lines && draw < 50 * config.num_lines; ++draw) {
     const Eigen::Vector3d A = randomScenePoint();
     const Eigen::Vector3d B = A + (0.5 + uniform(rng)) * randomVector().normalized();
     const Eigen::Vector3d M = 0.5 * (A + B);
@@ -152,6 +156,7 @@ inline SyntheticWindow makeSyntheticWindow(const SyntheticWindowConfig& config) 
                                }),
                 views.end());
     if (views.size() < 2) continue;
+    ++num_lines;
     const int first = static_cast<int>(w.P_world_true.size());
     for (int s = 0; s < config.samples_per_line; ++s) {
       const double t = (s + 0.5) / config.samples_per_line;
