@@ -13,12 +13,13 @@
 
 namespace plumb {
 
-// An RGB-D point measurement [u, v, u_r] (u_r < 0: no depth, a 2D-only [u, v] measurement) with
-// its information matrix from the front end's noise model.
+// An RGB-D point measurement [u, v, u_r] (has_depth false: a 2D-only [u, v] measurement) with its
+// information matrix from the front end's noise model.
 struct KeyframePointObservation {
   uint32_t point_slot = 0;
   uint16_t keypoint_index = 0;  // index into the keyframe's FrameFeatures at insertion
   int8_t octave = 0;
+  bool has_depth = true;
   Eigen::Vector3d uvr = Eigen::Vector3d::Zero();
   Eigen::Matrix3d info = Eigen::Matrix3d::Identity();
 };

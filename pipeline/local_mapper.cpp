@@ -1,7 +1,6 @@
 #include "pipeline/local_mapper.h"
 
 #include <algorithm>
-#include <cstdlib>
 
 #include "pipeline/map_line_geometry.h"
 #include "solver/noise_model.h"
@@ -80,7 +79,7 @@ InsertResult LocalMapper::insertKeyframe(const KeyframeRequest& request) {
   result.new_points = createPoints(kf_slot, request);
   result.new_lines = options_.tracker.use_lines ? createLines(kf_slot, request) : 0;
   if (!request.start_new_map) {
-    if (std::getenv("PLUMB_NO_BA") == nullptr) runLocalBa(kf_slot, &result);
+    runLocalBa(kf_slot, &result);
     cullLandmarks(kf.id);
   }
   const MapCounts counts = map_.counts();
@@ -116,8 +115,10 @@ KeyframePointObservation pointObservation(const KeypointObservation& kp, uint32_
   obs.point_slot = point_slot;
   obs.keypoint_index = index;
   obs.octave = kp.octave;
-  const bool has_depth = kp.depth_m > 0 && kp.u_right >= 0;
-  obs.uvr = Eigen::Vector3d(kp.px_undist.x(), kp.px_undist.y(), has_depth ? kp.u_right : -1.0);
+  // u_r may be negative (a near point at the left border): depth decides, not its sign.
+  obs.has_depth = kp.depth_m > 0;
+  const bool has_depth = obs.has_depth;
+  obs.uvr = Eigen::Vector3d(kp.px_undist.x(), kp.px_undist.y(), has_depth ? kp.u_right : 0.0);
   if (has_depth) {
     obs.info = kp.info_uvr.cast<double>();
     if (!(obs.info.trace() > 0)) obs.info = stereoPointInformation(noise, intrinsics, kp.octave, kp.depth_m);
@@ -175,7 +176,7 @@ int LocalMapper::createPoints(int kf_slot, const KeyframeRequest& request) {
   for (std::size_t k = 0; k < f.keypoints.size(); ++k) {
     const KeypointObservation& kp = f.keypoints[k];
     if (request.keypoint_landmark[k].id != 0) continue;
-    if (kp.depth_m <= 0 || kp.u_right < 0 || kp.depth_m > options_.mapper.max_new_point_depth_m) continue;
+    if (kp.depth_m <= 0 || kp.depth_m > options_.mapper.max_new_point_depth_m) continue;
     (void)order.push_back({kp.depth_m, uint16_t(k)});
   }
   std::sort(order.begin(), order.end());  // ties broken by keypoint index: deterministic

@@ -114,7 +114,7 @@ void LocalMapper::runLocalBa(int kf_slot, InsertResult* result) {
     for (const auto& obs : kf.points) {
       if (s_->point_stamp[obs.point_slot] != stamp_ || num_obs >= max_obs) continue;
       const int landmark = s_->point_ba_index[obs.point_slot];
-      const int o = obs.uvr.z() >= 0
+      const int o = obs.has_depth
                         ? ba_.addStereoPointObservation(kf_index, landmark, obs.uvr, obs.info)
                         : ba_.addMonoPointObservation(kf_index, landmark, obs.uvr.head<2>(),
                                                       obs.info.topLeftCorner<2, 2>());

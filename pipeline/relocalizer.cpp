@@ -168,7 +168,7 @@ int Relocalizer::refine(const FrameFeatures& frame, const StoredKeyframe& kf, Ei
     const KeypointObservation& kp = frame.keypoints[c[i].keypoint];
     PosePointObservation* obs = points.emplace_back();
     obs->P_world = kf.T_world_cam * c[i].P_stored;
-    obs->has_depth = kp.u_right >= 0;
+    obs->has_depth = kp.depth_m > 0;
     obs->z = Eigen::Vector3d(kp.px_undist.x(), kp.px_undist.y(), obs->has_depth ? kp.u_right : 0.0);
     obs->information = kp.info_uvr.cast<double>();
     if (!obs->has_depth || !(obs->information.trace() > 0)) {

@@ -21,7 +21,7 @@ PoseResult Tracker::optimizeAndPrune(const FrameFeatures& frame, const Eigen::Is
     const KeypointObservation& kp = frame.keypoints[k];
     PosePointObservation* obs = points.emplace_back();
     obs->P_world = b_->points[k].P_world;
-    obs->has_depth = kp.depth_m > 0 && kp.u_right >= 0;
+    obs->has_depth = kp.depth_m > 0;  // u_r itself may be negative near the left border
     obs->z = Eigen::Vector3d(kp.px_undist.x(), kp.px_undist.y(), obs->has_depth ? kp.u_right : 0.0);
     if (obs->has_depth) {
       obs->information = kp.info_uvr.cast<double>();
