@@ -51,7 +51,7 @@ class V4l2Source : public FrameSource {
   const V4l2PairingStats& pairingStats() const { return stats_; }
 
  private:
-  V4l2Source(V4l2Device& device) : colour_(device), depth_(device) {}
+  explicit V4l2Source(V4l2Device& device) : colour_(device), depth_(device) {}
   Status openNodes();
   SourceResult fail(const Status& error);
   bool convert(RgbdImage& out);
