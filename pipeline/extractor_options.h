@@ -2,6 +2,8 @@
 // ExtractorOptions: every tunable of the measurement front end (ORB points, LSD lines + LBD-style
 // descriptors, depth back-projection with the paper's noise model, line-guidance sampling).
 // Defaults are the values used by `plumb bench frontend` and the tests; tools/ may override them.
+#include <string>
+
 #include "pipeline/capacities.h"
 #include "solver/noise_model.h"
 
@@ -49,6 +51,25 @@ struct ExtractorOptions {
   // sigma_d = 0.0015 * d^2 m. Its scale_factor should equal `scale_factor` above.
   NoiseModelOptions noise;
 };
+
+// Empty when usable; otherwise which option is out of range (tools/ turn this into a Status).
+// FeatureExtractor clamps out-of-range values, so callers that skip this still do not crash.
+inline std::string validate(const ExtractorOptions& o) {
+  if (o.num_features < 1 || o.num_features > static_cast<int>(kMaxKeypoints))
+    return "num_features must be in 1.." + std::to_string(kMaxKeypoints);
+  if (o.num_levels < 1 || o.num_levels > kPyramidLevels) return "num_levels must be in 1.." + std::to_string(kPyramidLevels);
+  if (!(o.scale_factor > 1.0f)) return "scale_factor must be > 1";
+  if (o.fast_threshold_low < 1 || o.fast_threshold_high < o.fast_threshold_low || o.fast_threshold_high > 254)
+    return "FAST thresholds must satisfy 1 <= low <= high <= 254";
+  if (o.cell_size_px < 8) return "cell_size_px must be >= 8";
+  if (o.max_lines < 0 || o.max_lines > static_cast<int>(kMaxLines)) return "max_lines must be in 0.." + std::to_string(kMaxLines);
+  if (o.line_level < 0 || o.line_level >= o.num_levels) return "line_level must be a pyramid level";
+  if (o.line_samples < 0 || o.line_samples > static_cast<int>(kMaxLineSamples))
+    return "line_samples must be in 0.." + std::to_string(kMaxLineSamples);
+  if (!(o.min_depth_m > 0) || !(o.max_depth_m > o.min_depth_m)) return "need 0 < min_depth_m < max_depth_m";
+  if (o.min_line_inliers < 2) return "min_line_inliers must be >= 2";
+  return "";
+}
 
 // Cost of the last extract() call in milliseconds: wall clock (steady clock) and, in the *_cpu_ms
 // fields, this thread's CPU time (CLOCK_THREAD_CPUTIME_ID), which does not count time the thread

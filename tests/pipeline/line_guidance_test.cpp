@@ -205,6 +205,19 @@ TEST(LineGuidance, PointsOnlyAndSampleCountOptionsAreHonoured) {
   EXPECT_GT(features->keypoints.size(), 500u);
 }
 
+TEST(ExtractorOptionsValidation, DefaultsAreValidAndBadValuesAreNamed) {
+  EXPECT_EQ(validate(ExtractorOptions()), "");
+  ExtractorOptions o;
+  o.line_samples = 11;
+  EXPECT_NE(validate(o).find("line_samples"), std::string::npos);
+  o = ExtractorOptions();
+  o.line_level = 8;
+  EXPECT_NE(validate(o).find("line_level"), std::string::npos);
+  o = ExtractorOptions();
+  o.num_features = 5000;
+  EXPECT_NE(validate(o).find("num_features"), std::string::npos);
+}
+
 TEST(LineGuidance, RealFrameLinesAreRankedAndMostlyHave3d) {
   RgbdImage frame;
   if (!test::loadTumRpyFrame(20, &frame)) GTEST_SKIP() << "TUM fr1/rpy not found under " << test::tumRpyDir();
