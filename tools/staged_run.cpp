@@ -5,6 +5,7 @@
 #include <memory>
 #include <utility>
 
+#include "drivers/dataset/tum_dataset.h"
 #include "pipeline/feature_extractor.h"
 #include "platform/allocation_counter.h"
 #include "runtime/chrome_trace.h"
@@ -79,6 +80,33 @@ class CaptureStage final : public runtime::Source<OdometrySlot> {
   Status error_;
 };
 
+// Stage 0 for a TUM-layout replay: timestamps come from the frame list, so peeking and skipping
+// cost nothing and only frames that get a slot are decoded (straight into the slot). In real-time
+// mode a replay that decodes every frame ahead falls behind as soon as decoding is slower than the
+// frame rate; this one only decodes what it delivers.
+class TumReplayCapture final : public runtime::Source<OdometrySlot> {
+ public:
+  TumReplayCapture(TumDatasetSource& replay, long max_frames) : replay_(replay), max_frames_(max_frames) {}
+
+  bool peekNext(int64_t* t_recorded_ns) override {
+    if (next_ >= replay_.size()) return false;
+    if (max_frames_ >= 0 && next_ >= static_cast<std::size_t>(max_frames_)) return false;
+    *t_recorded_ns = std::llround(replay_.timestamp(next_) * 1e9);
+    return true;
+  }
+  Status read(OdometrySlot& slot, const runtime::FrameStamps& stamps) override {
+    const Status status = replay_.load(next_++, slot.image);
+    slot.image.t_sensor_ns = stamps.t_sensor_ns;
+    return status;
+  }
+  void skip() override { ++next_; }
+
+ private:
+  TumDatasetSource& replay_;
+  long max_frames_;
+  std::size_t next_ = 0;  // the replay's own cursor is not used: load() is random access
+};
+
 // Stage 1: its own FeatureExtractor (extractors are one per thread), same options as the system's.
 class ExtractStage final : public runtime::Stage<OdometrySlot> {
  public:
@@ -136,7 +164,13 @@ class OdometryStage final : public runtime::Stage<OdometrySlot> {
 
 Status runStaged(FrameSource& source, OdometrySystem& system, const StagedRunOptions& options,
                  const FrameOutputFn& on_output, StagedRunResult* result) {
-  CaptureStage capture(source, options.max_frames);
+  // A TUM replay is read by index (cheap peek/skip); any other source through next() + read-ahead.
+  CaptureStage generic_capture(source, options.max_frames);
+  auto* replay = dynamic_cast<TumDatasetSource*>(&source);
+  std::unique_ptr<TumReplayCapture> replay_capture;
+  if (replay != nullptr) replay_capture = std::make_unique<TumReplayCapture>(*replay, options.max_frames);
+  runtime::Source<OdometrySlot>& capture =
+      replay_capture ? static_cast<runtime::Source<OdometrySlot>&>(*replay_capture) : generic_capture;
   ExtractStage extract(system.extractor());
   OdometryStage odometry(system, on_output, options.warmup_frames);
   runtime::RunOptions run_options;

@@ -48,7 +48,9 @@ struct StagedRunResult {
 using FrameOutputFn = std::function<Status(const FrameOutput&)>;
 
 // Runs source -> extract -> odometry until the source ends, max_frames, or an error. The system
-// must be fresh or continue a previous run; call system.finish() afterwards as usual.
+// must be fresh or continue a previous run; call system.finish() afterwards as usual. A TUM-layout
+// replay (TumDatasetSource) is played by index from its first frame, so dropped frames are never
+// decoded; other sources are read through next() one frame ahead.
 Status runStaged(FrameSource& source, OdometrySystem& system, const StagedRunOptions& options,
                  const FrameOutputFn& on_output, StagedRunResult* result);
 
