@@ -68,7 +68,7 @@ void FastDetector::scan(int threshold, int x0, int y0, int x1, int y1) {
   int circle[16];
   for (int k = 0; k < 16; ++k) circle[k] = kCircleY[k] * stride + kCircleX[k];
   const cv::v_uint8x16 t = cv::v_setall_u8(static_cast<uint8_t>(threshold));
-  const cv::v_uint8x16 one = cv::v_setall_u8(1), two = cv::v_setall_u8(2);
+  const cv::v_uint8x16 one = cv::v_setall_u8(1), two = cv::v_setall_u8(2), four = cv::v_setall_u8(4);
   auto record = [&](uint8_t* score_row, int x, int y, int score) {
     if (score <= threshold) return;
     score_row[x] = static_cast<uint8_t>(std::min(score, 255));
@@ -90,7 +90,16 @@ void FastDetector::scan(int threshold, int x0, int y0, int x1, int y1) {
         bright += (q > hi) & one;
         dark += (q < lo) & one;
       }
-      const cv::v_uint8x16 maybe = (bright >= two) | (dark >= two);
+      cv::v_uint8x16 maybe = (bright >= two) | (dark >= two);
+      if (!cv::v_check_any(maybe)) return;
+      // Second filter on the four diagonal-ish even pixels: an arc of 9 covers >= 4 of the 8 even
+      // circle positions, so a corner needs >= 4 of them on one side.
+      for (int k = 2; k < 16; k += 4) {
+        const cv::v_uint8x16 q = cv::v_load(row + bx + circle[k]);
+        bright += (q > hi) & one;
+        dark += (q < lo) & one;
+      }
+      maybe = (bright >= four) | (dark >= four);
       if (!cv::v_check_any(maybe)) return;
       // Score of all 16 lanes at once, in saturating u8 arithmetic: with b_k = sat(I_k - c) and
       // e_k = sat(c - I_k), the score is the max over the 16 arcs of 9 of min(b) or min(e);
