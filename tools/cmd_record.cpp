@@ -25,8 +25,8 @@ void printHelp() {
       "  --out FILE       output recording (overwritten)\n"
       "  --frames N       stop after N frames (default: until the source ends)\n"
       "  --codec C        auto (default: raw for live sensors, png otherwise), raw or png; both\n"
-      "                   lossless. png is ~2.6x smaller but encodes at ~10 frames/s at 640x480,\n"
-      "                   too slow for a 30 Hz sensor; raw needs ~46 MB/s of disk at 30 Hz\n"
+      "                   lossless. png is ~3x smaller but costs ~20 ms of CPU per 640x480 frame,\n"
+      "                   most of a 30 Hz frame period; raw needs ~46 MB/s of disk at 30 Hz\n"
       "  --fsync P        never | index (default: after every index chunk) | frame\n");
 }
 

