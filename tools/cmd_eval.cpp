@@ -27,8 +27,8 @@ Status readTrajectory(const char* role, const std::string& path, std::vector<Sta
   return readTumTrajectory(path, poses, {}, report).withContext(std::string("reading ") + role);
 }
 
-void printJson(const std::string& gt, const std::string& est, const AteResult& ate,
-               const RpeResult* rpe, const std::string& plot) {
+void printJson(const std::string& gt, const std::string& est, const AteResult& ate, const RpeResult* rpe,
+               const std::string& plot) {
   // Paths are printed verbatim apart from escaping the two characters JSON requires.
   auto quoted = [](const std::string& s) {
     std::string out = "\"";
@@ -40,15 +40,17 @@ void printJson(const std::string& gt, const std::string& est, const AteResult& a
   };
   std::printf("{\"ground_truth\": %s, \"estimate\": %s,\n", quoted(gt).c_str(), quoted(est).c_str());
   const ErrorStatistics& a = ate.translation_m;
-  std::printf(" \"ate\": {\"pairs\": %zu, \"rmse_m\": %.6f, \"mean_m\": %.6f, \"median_m\": %.6f, "
-              "\"max_m\": %.6f},\n",
-              ate.pairs, a.rmse, a.mean, a.median, a.max);
+  std::printf(
+      " \"ate\": {\"pairs\": %zu, \"rmse_m\": %.6f, \"mean_m\": %.6f, \"median_m\": %.6f, "
+      "\"max_m\": %.6f},\n",
+      ate.pairs, a.rmse, a.mean, a.median, a.max);
   if (rpe) {
-    std::printf(" \"rpe\": {\"pairs\": %zu, \"delta_s\": 1.0, \"translation_rmse_m_per_s\": %.6f, "
-                "\"translation_mean_m_per_s\": %.6f, \"rotation_rmse_deg_per_s\": %.6f, "
-                "\"rotation_mean_deg_per_s\": %.6f}",
-                rpe->pairs, rpe->translation_m_per_s.rmse, rpe->translation_m_per_s.mean,
-                rpe->rotation_deg_per_s.rmse, rpe->rotation_deg_per_s.mean);
+    std::printf(
+        " \"rpe\": {\"pairs\": %zu, \"delta_s\": 1.0, \"translation_rmse_m_per_s\": %.6f, "
+        "\"translation_mean_m_per_s\": %.6f, \"rotation_rmse_deg_per_s\": %.6f, "
+        "\"rotation_mean_deg_per_s\": %.6f}",
+        rpe->pairs, rpe->translation_m_per_s.rmse, rpe->translation_m_per_s.mean,
+        rpe->rotation_deg_per_s.rmse, rpe->rotation_deg_per_s.mean);
   } else {
     std::printf(" \"rpe\": null");
   }
@@ -57,8 +59,8 @@ void printJson(const std::string& gt, const std::string& est, const AteResult& a
 
 void printText(const AteResult& ate, const RpeResult* rpe, const std::string& rpe_note) {
   const ErrorStatistics& a = ate.translation_m;
-  std::printf("ATE RMSE %.4f m over %zu pairs (mean %.4f, median %.4f, max %.4f m)\n", a.rmse,
-              ate.pairs, a.mean, a.median, a.max);
+  std::printf("ATE RMSE %.4f m over %zu pairs (mean %.4f, median %.4f, max %.4f m)\n", a.rmse, ate.pairs,
+              a.mean, a.median, a.max);
   if (rpe) {
     std::printf("RPE translation RMSE %.4f m/s, rotation RMSE %.4f deg/s over %zu pairs (delta 1 s)\n",
                 rpe->translation_m_per_s.rmse, rpe->rotation_deg_per_s.rmse, rpe->pairs);
@@ -75,9 +77,9 @@ int runEval(int argc, char** argv) {
   }
   if (!args.error().empty() || !args.positional().empty() || !args.has("gt") || !args.has("est")) {
     std::fprintf(stderr, "plumb eval: %s\n",
-                 !args.error().empty()          ? args.error().c_str()
+                 !args.error().empty()        ? args.error().c_str()
                  : !args.positional().empty() ? ("unexpected argument " + args.positional()[0]).c_str()
-                                                : "--gt and --est are required");
+                                              : "--gt and --est are required");
     printEvalUsage();
     return 2;
   }
@@ -100,7 +102,8 @@ int runEval(int argc, char** argv) {
   AteResult ate;
   Status st = evaluateAte(ground_truth, estimate, {}, &ate);
   if (!st.ok()) {
-    std::fprintf(stderr, "plumb eval: %s vs %s: %s\n", est_path.c_str(), gt_path.c_str(), st.message().c_str());
+    std::fprintf(stderr, "plumb eval: %s vs %s: %s\n", est_path.c_str(), gt_path.c_str(),
+                 st.message().c_str());
     return 1;
   }
   // A short estimate (< 1 s) has no RPE pairs: report that, ATE is still meaningful.

@@ -25,8 +25,8 @@ std::string cameraPresetFromFolderName(const std::string& folder) {
   const struct {
     const char* pattern;
     const char* preset;
-  } rules[] = {{"freiburg1", "tum1"}, {"fr1", "tum1"}, {"freiburg2", "tum2"}, {"fr2", "tum2"},
-               {"freiburg3", "tum3"}, {"fr3", "tum3"}, {"icl", "icl"},       {"living_room", "icl"},
+  } rules[] = {{"freiburg1", "tum1"}, {"fr1", "tum1"},        {"freiburg2", "tum2"}, {"fr2", "tum2"},
+               {"freiburg3", "tum3"}, {"fr3", "tum3"},        {"icl", "icl"},        {"living_room", "icl"},
                {"livingroom", "icl"}, {"office_room", "icl"}, {"frei_png", "icl"}};
   for (const auto& rule : rules)
     if (name.find(rule.pattern) != std::string::npos) return rule.preset;
@@ -83,7 +83,8 @@ Status openFrameSource(const std::string& spec, const std::string& camera_spec,
     camera_choice = std::ifstream(folder_camera).good() ? folder_camera : cameraPresetFromFolderName(spec);
   }
   if (camera_choice.empty())
-    return Status::Error(spec + ": no camera.txt and the folder name does not name the sensor; "
+    return Status::Error(spec +
+                         ": no camera.txt and the folder name does not name the sensor; "
                          "pass a camera (tum1 tum2 tum3 icl or a camera file)");
   PinholeCamera camera;
   PLUMB_RETURN_IF_ERROR(cameraFromSpec(camera_choice, &camera));

@@ -2,6 +2,7 @@
 // openFrameSource: turns a command-line source specification into a FrameSource.
 //   DIR                          TUM RGB-D / ICL-NUIM (TUM format) folder
 //   synth:PRESET[:SEED[:FRAMES]] synthetic scene rendered on the fly (drivers/synth)
+//   recordings, .oni files, openni2:, v4l2: see drivers/recording/sensor_source_specs.h
 // camera_spec is a preset (tum1 tum2 tum3 icl) or a camera file. When empty: the folder's own
 // camera.txt if present, else the preset its name implies (freiburg1/fr1 -> tum1, fr2 -> tum2,
 // fr3 -> tum3, icl/living_room/office_room/frei_png -> icl), else an error asking for a camera.

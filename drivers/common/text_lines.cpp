@@ -63,8 +63,7 @@ bool parseInt(const std::string& token, int* value) {
   char* end = nullptr;
   errno = 0;
   const long v = std::strtol(token.c_str(), &end, 10);
-  if (end != token.c_str() + token.size() || errno == ERANGE || v < INT_MIN || v > INT_MAX)
-    return false;
+  if (end != token.c_str() + token.size() || errno == ERANGE || v < INT_MIN || v > INT_MAX) return false;
   *value = static_cast<int>(v);
   return true;
 }

@@ -25,8 +25,7 @@ std::vector<IndexPair> associateTimestamps(const std::vector<double>& first_sort
   std::size_t window_begin = 0;
   for (std::size_t i = 0; i < first_sorted.size(); ++i) {
     const double a = first_sorted[i];
-    while (window_begin < second_sorted.size() &&
-           second_sorted[window_begin] + options.offset_s < a - window)
+    while (window_begin < second_sorted.size() && second_sorted[window_begin] + options.offset_s < a - window)
       ++window_begin;
     for (std::size_t j = window_begin; j < second_sorted.size(); ++j) {
       const double b = second_sorted[j] + options.offset_s;

@@ -21,11 +21,16 @@ struct CameraKey {
 
 std::map<std::string, CameraKey> cameraKeys(PinholeCamera* c) {
   return {
-      {"fx", {&c->fx, nullptr, true, true}},     {"fy", {&c->fy, nullptr, true, true}},
-      {"cx", {&c->cx, nullptr, true, false}},    {"cy", {&c->cy, nullptr, true, false}},
-      {"k1", {&c->k1, nullptr, false, false}},   {"k2", {&c->k2, nullptr, false, false}},
-      {"p1", {&c->p1, nullptr, false, false}},   {"p2", {&c->p2, nullptr, false, false}},
-      {"k3", {&c->k3, nullptr, false, false}},   {"width", {nullptr, &c->width, false, true}},
+      {"fx", {&c->fx, nullptr, true, true}},
+      {"fy", {&c->fy, nullptr, true, true}},
+      {"cx", {&c->cx, nullptr, true, false}},
+      {"cy", {&c->cy, nullptr, true, false}},
+      {"k1", {&c->k1, nullptr, false, false}},
+      {"k2", {&c->k2, nullptr, false, false}},
+      {"p1", {&c->p1, nullptr, false, false}},
+      {"p2", {&c->p2, nullptr, false, false}},
+      {"k3", {&c->k3, nullptr, false, false}},
+      {"width", {nullptr, &c->width, false, true}},
       {"height", {nullptr, &c->height, false, true}},
       {"depth_factor", {&c->depth_factor, nullptr, false, true}},
       {"baseline", {&c->baseline_m, nullptr, false, true}},
@@ -44,8 +49,8 @@ Status readCameraFile(const std::string& path, PinholeCamera* out) {
     if (line.is_comment) continue;
     const std::string where = fileLine(path, line.number);
     if (line.tokens.size() != 2)
-      return Status::Error(where + ": expected `key value`, got " +
-                           std::to_string(line.tokens.size()) + " fields");
+      return Status::Error(where + ": expected `key value`, got " + std::to_string(line.tokens.size()) +
+                           " fields");
     const std::string& key = line.tokens[0];
     const std::string& text = line.tokens[1];
     auto it = keys.find(key);
@@ -87,9 +92,8 @@ Status writeCameraFile(const std::string& path, const PinholeCamera& camera) {
   const struct {
     const char* key;
     double value;
-  } reals[] = {{"fx", camera.fx}, {"fy", camera.fy}, {"cx", camera.cx}, {"cy", camera.cy},
-               {"k1", camera.k1}, {"k2", camera.k2}, {"p1", camera.p1}, {"p2", camera.p2},
-               {"k3", camera.k3}};
+  } reals[] = {{"fx", camera.fx}, {"fy", camera.fy}, {"cx", camera.cx}, {"cy", camera.cy}, {"k1", camera.k1},
+               {"k2", camera.k2}, {"p1", camera.p1}, {"p2", camera.p2}, {"k3", camera.k3}};
   for (const auto& r : reals) std::fprintf(file, "%s %.17g\n", r.key, r.value);
   std::fprintf(file, "width %d\nheight %d\n", camera.width, camera.height);
   std::fprintf(file, "depth_factor %.17g\nbaseline %.17g\n", camera.depth_factor, camera.baseline_m);

@@ -3,7 +3,6 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
-
 #include <opencv2/imgcodecs.hpp>
 
 #include "drivers/dataset/tum_lists.h"

@@ -28,9 +28,8 @@ Status checkIncreasing(const std::string& where, const char* what, double previo
                        double current) {
   if (current > previous) return Status::Ok();
   const std::string kind = current == previous ? "duplicate " : "non-monotonic ";
-  return Status::Error(where + ": " + kind + what + " timestamp " + formatStamp(current) +
-                       " (previous " + formatStamp(previous) + " on line " +
-                       std::to_string(previous_line) + ")");
+  return Status::Error(where + ": " + kind + what + " timestamp " + formatStamp(current) + " (previous " +
+                       formatStamp(previous) + " on line " + std::to_string(previous_line) + ")");
 }
 
 bool startsWith(const std::string& text, const char* prefix) { return text.rfind(prefix, 0) == 0; }
@@ -52,8 +51,8 @@ Status readTumImageList(const std::string& list_path, std::vector<TumListEntry>*
     entry.path = line.tokens[1];
     entry.line = line.number;
     if (!out->empty())
-      PLUMB_RETURN_IF_ERROR(checkIncreasing(where, "image", out->back().timestamp_s,
-                                            out->back().line, entry.timestamp_s));
+      PLUMB_RETURN_IF_ERROR(
+          checkIncreasing(where, "image", out->back().timestamp_s, out->back().line, entry.timestamp_s));
     out->push_back(std::move(entry));
   }
   if (out->empty()) return Status::Error(list_path + ": empty list (no image lines)");
@@ -81,10 +80,10 @@ Status readTumAssociations(const std::string& list_path, std::vector<TumFrameEnt
     PLUMB_RETURN_IF_ERROR(parseStamp(where, line.tokens[depth_column], &entry.depth_timestamp_s));
     entry.depth_path = line.tokens[depth_column + 1];
     if (!out->empty()) {
-      PLUMB_RETURN_IF_ERROR(checkIncreasing(where, "rgb", out->back().rgb_timestamp_s,
-                                            previous_line, entry.rgb_timestamp_s));
-      PLUMB_RETURN_IF_ERROR(checkIncreasing(where, "depth", out->back().depth_timestamp_s,
-                                            previous_line, entry.depth_timestamp_s));
+      PLUMB_RETURN_IF_ERROR(
+          checkIncreasing(where, "rgb", out->back().rgb_timestamp_s, previous_line, entry.rgb_timestamp_s));
+      PLUMB_RETURN_IF_ERROR(checkIncreasing(where, "depth", out->back().depth_timestamp_s, previous_line,
+                                            entry.depth_timestamp_s));
     }
     previous_line = line.number;
     out->push_back(std::move(entry));

@@ -1,8 +1,8 @@
 #pragma once
 // Readers of the TUM list files: rgb.txt / depth.txt (`timestamp filename`) and associations.txt
 // (`t_rgb rgb/X.png t_depth depth/Y.png`; also depth-first lines `t_depth depth/Y.png t_rgb rgb/X.png`,
-// recognised by the folder names, as ICL-NUIM and some tools write them). Each checks that the list is not empty, every line
-// parses, and timestamps strictly increase; errors name the file and line.
+// recognised by the folder names, as ICL-NUIM and some tools write them). Each checks that the list is not
+// empty, every line parses, and timestamps strictly increase; errors name the file and line.
 #include <string>
 #include <vector>
 

@@ -11,10 +11,9 @@
 // must lie within 2x the median ground-truth interval. Error E = (E_i^-1 E_j) (G_i^-1 G_j)^-1;
 // translation |t(E)| and rotation angle(E) over that ~1 s interval, reported per second (m/s and
 // deg/s), not divided by the exact interval (the benchmark's convention).
+#include <Eigen/Geometry>
 #include <cstddef>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "drivers/common/timestamp_association.h"
 #include "drivers/trajectory/trajectory_io.h"
@@ -32,22 +31,21 @@ struct AteOptions {
 
 // One associated pair after alignment (for plots).
 struct AteSample {
-  double timestamp_s = 0;              // the ground truth's stamp
-  Eigen::Vector3d p_world_gt;          // ground-truth camera position
-  Eigen::Vector3d p_world_est_aligned; // estimate position mapped by T_gt_est
+  double timestamp_s = 0;               // the ground truth's stamp
+  Eigen::Vector3d p_world_gt;           // ground-truth camera position
+  Eigen::Vector3d p_world_est_aligned;  // estimate position mapped by T_gt_est
 };
 
 struct AteResult {
   std::size_t pairs = 0;
   ErrorStatistics translation_m;
   Eigen::Isometry3d T_gt_est = Eigen::Isometry3d::Identity();  // aligns estimate world to gt world
-  std::vector<AteSample> samples;  // sorted by time
+  std::vector<AteSample> samples;                              // sorted by time
 };
 
 // Invalid (lost) poses are ignored. Error if fewer than 3 pairs associate.
-Status evaluateAte(const std::vector<StampedPose>& ground_truth,
-                   const std::vector<StampedPose>& estimate, const AteOptions& options,
-                   AteResult* out);
+Status evaluateAte(const std::vector<StampedPose>& ground_truth, const std::vector<StampedPose>& estimate,
+                   const AteOptions& options, AteResult* out);
 
 struct RpeOptions {
   double delta_s = 1.0;  // interval of the relative motion (benchmark: 1 s)
@@ -60,9 +58,8 @@ struct RpeResult {
 };
 
 // Error if no pair survives (estimate shorter than delta, or no ground truth near it).
-Status evaluateRpe(const std::vector<StampedPose>& ground_truth,
-                   const std::vector<StampedPose>& estimate, const RpeOptions& options,
-                   RpeResult* out);
+Status evaluateRpe(const std::vector<StampedPose>& ground_truth, const std::vector<StampedPose>& estimate,
+                   const RpeOptions& options, RpeResult* out);
 
 // Statistics of a list of non-negative errors (copy sorted for the median). Empty -> zeros.
 ErrorStatistics computeErrorStatistics(const std::vector<double>& errors);

@@ -3,9 +3,8 @@
 
 namespace plumb {
 
-Status evaluateAte(const std::vector<StampedPose>& ground_truth,
-                   const std::vector<StampedPose>& estimate, const AteOptions& options,
-                   AteResult* out) {
+Status evaluateAte(const std::vector<StampedPose>& ground_truth, const std::vector<StampedPose>& estimate,
+                   const AteOptions& options, AteResult* out) {
   std::vector<const StampedPose*> gt_poses, est_poses;
   std::vector<double> gt_stamps, est_stamps;
   for (const StampedPose& p : ground_truth) {

@@ -30,9 +30,8 @@ double rotationAngleRad(const Eigen::Matrix3d& R) {
 
 }  // namespace
 
-Status evaluateRpe(const std::vector<StampedPose>& ground_truth,
-                   const std::vector<StampedPose>& estimate, const RpeOptions& options,
-                   RpeResult* out) {
+Status evaluateRpe(const std::vector<StampedPose>& ground_truth, const std::vector<StampedPose>& estimate,
+                   const RpeOptions& options, RpeResult* out) {
   std::vector<const StampedPose*> gt, est;
   std::vector<double> gt_stamps, est_stamps;
   for (const StampedPose& p : ground_truth) {
@@ -45,8 +44,7 @@ Status evaluateRpe(const std::vector<StampedPose>& ground_truth,
     est.push_back(&p);
     est_stamps.push_back(p.timestamp);
   }
-  if (gt.size() < 2 || est.size() < 2)
-    return Status::Error("RPE: needs at least 2 poses in each trajectory");
+  if (gt.size() < 2 || est.size() < 2) return Status::Error("RPE: needs at least 2 poses in each trajectory");
 
   // A ground-truth stamp further than two of its usual intervals away means a gap: skip the pair.
   const double gt_max_dt = 2.0 * medianInterval(gt_stamps);

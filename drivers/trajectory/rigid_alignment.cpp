@@ -4,11 +4,11 @@
 
 namespace plumb {
 
-Status alignRigid(const std::vector<Eigen::Vector3d>& p_source,
-                  const std::vector<Eigen::Vector3d>& p_target, Eigen::Isometry3d* T_target_source) {
+Status alignRigid(const std::vector<Eigen::Vector3d>& p_source, const std::vector<Eigen::Vector3d>& p_target,
+                  Eigen::Isometry3d* T_target_source) {
   if (p_source.size() != p_target.size())
-    return Status::Error("rigid alignment: point counts differ (" + std::to_string(p_source.size()) +
-                         " vs " + std::to_string(p_target.size()) + ")");
+    return Status::Error("rigid alignment: point counts differ (" + std::to_string(p_source.size()) + " vs " +
+                         std::to_string(p_target.size()) + ")");
   const std::size_t n = p_source.size();
   if (n < 3) return Status::Error("rigid alignment: needs at least 3 point pairs, got " + std::to_string(n));
 
@@ -37,8 +37,7 @@ Status alignRigid(const std::vector<Eigen::Vector3d>& p_source,
   // smallest singular value instead.
   Eigen::Matrix3d reflection_guard = Eigen::Matrix3d::Identity();
   if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0) reflection_guard(2, 2) = -1;
-  const Eigen::Matrix3d R_target_source =
-      svd.matrixU() * reflection_guard * svd.matrixV().transpose();
+  const Eigen::Matrix3d R_target_source = svd.matrixU() * reflection_guard * svd.matrixV().transpose();
 
   T_target_source->setIdentity();
   T_target_source->linear() = R_target_source;

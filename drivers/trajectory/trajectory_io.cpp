@@ -21,8 +21,8 @@ bool parseLostMarker(const TextLine& line, double* timestamp) {
          parseDouble(line.tokens[0], timestamp) && std::isfinite(*timestamp);
 }
 
-Status parsePoseLine(const std::string& where, const TextLine& line,
-                     const TrajectoryReadOptions& options, StampedPose* pose, bool* normalised) {
+Status parsePoseLine(const std::string& where, const TextLine& line, const TrajectoryReadOptions& options,
+                     StampedPose* pose, bool* normalised) {
   if (line.tokens.size() != 8)
     return Status::Error(where + ": expected 8 fields `timestamp tx ty tz qx qy qz qw`, got " +
                          std::to_string(line.tokens.size()));
@@ -37,8 +37,7 @@ Status parsePoseLine(const std::string& where, const TextLine& line,
   const double norm = q_world_cam.norm();
   if (norm < 1e-9) return Status::Error(where + ": zero quaternion");
   if (std::abs(norm - 1.0) > options.quaternion_norm_tolerance)
-    return Status::Error(where + ": quaternion norm " + formatNumber("%.6g", norm) +
-                         " is not 1 (tolerance " +
+    return Status::Error(where + ": quaternion norm " + formatNumber("%.6g", norm) + " is not 1 (tolerance " +
                          formatNumber("%g", options.quaternion_norm_tolerance) + ")");
   *normalised = std::abs(norm - 1.0) > 1e-6;
   q_world_cam.normalize();
@@ -74,9 +73,8 @@ Status readTumTrajectory(const std::string& path, std::vector<StampedPose>* out,
     if (!out->empty()) {
       const double previous = out->back().timestamp;
       if (pose.timestamp < previous)
-        return Status::Error(where + ": non-monotonic timestamp " +
-                             formatNumber("%.6f", pose.timestamp) + " (previous " +
-                             formatNumber("%.6f", previous) + " on line " +
+        return Status::Error(where + ": non-monotonic timestamp " + formatNumber("%.6f", pose.timestamp) +
+                             " (previous " + formatNumber("%.6f", previous) + " on line " +
                              std::to_string(previous_line) + ")");
       if (pose.timestamp == previous) {
         // The benchmark's dictionary keeps the later line; so do we, and count it.
@@ -104,8 +102,8 @@ std::string formatTumLine(const StampedPose& pose) {
   Eigen::Quaterniond q(pose.T_world_cam.rotation());
   // q and -q are the same rotation; pick qw >= 0 so equal poses always print the same bytes.
   if (q.w() < 0) q.coeffs() = -q.coeffs();
-  std::snprintf(text, sizeof(text), "%.6f %.9g %.9g %.9g %.9g %.9g %.9g %.9g", pose.timestamp,
-                t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+  std::snprintf(text, sizeof(text), "%.6f %.9g %.9g %.9g %.9g %.9g %.9g %.9g", pose.timestamp, t.x(), t.y(),
+                t.z(), q.x(), q.y(), q.z(), q.w());
   return text;
 }
 
@@ -125,9 +123,10 @@ Status TumTrajectoryWriter::open(const std::string& path) {
   path_ = path;
   file_ = std::fopen(path.c_str(), "wb");
   if (!file_) return Status::Error(path + ": cannot write trajectory (" + std::strerror(errno) + ")");
-  std::fputs("# plumb trajectory: timestamp tx ty tz qx qy qz qw (T_world_cam); "
-             "'# <timestamp> lost' = no pose\n",
-             file_);
+  std::fputs(
+      "# plumb trajectory: timestamp tx ty tz qx qy qz qw (T_world_cam); "
+      "'# <timestamp> lost' = no pose\n",
+      file_);
   return Status::Ok();
 }
 

@@ -6,11 +6,10 @@
 // plumb writes one line per input frame. A frame without a pose (tracking lost, not initialised)
 // is written as the comment line `# <timestamp> lost`, so the benchmark tools still parse the file
 // and simply see no pose at that time. See docs/DATA_FORMATS.md.
+#include <Eigen/Geometry>
 #include <cstdio>
 #include <string>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "platform/status.h"
 
@@ -40,8 +39,7 @@ struct TrajectoryReadReport {
 // Errors name file and line: wrong column count, unparsable or non-finite numbers, zero or
 // far-from-unit quaternions, decreasing timestamps, no poses at all.
 Status readTumTrajectory(const std::string& path, std::vector<StampedPose>* out,
-                         const TrajectoryReadOptions& options = {},
-                         TrajectoryReadReport* report = nullptr);
+                         const TrajectoryReadOptions& options = {}, TrajectoryReadReport* report = nullptr);
 
 // One line for a pose: `%.6f` timestamp, `%.9g` numbers, or `# %.6f lost` when !valid.
 // Deterministic bytes (C locale number formatting, no trailing spaces), no newline.

@@ -5,7 +5,6 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -92,8 +91,7 @@ void drawPolyline(cv::Mat& image, const AteResult& ate, const std::vector<cv::Po
                   const cv::Scalar& colour, int thickness) {
   std::size_t start = 0;
   for (std::size_t i = 1; i <= points.size(); ++i) {
-    if (i < points.size() && ate.samples[i].timestamp_s - ate.samples[i - 1].timestamp_s <= kGapS)
-      continue;
+    if (i < points.size() && ate.samples[i].timestamp_s - ate.samples[i - 1].timestamp_s <= kGapS) continue;
     if (i - start >= 2) {
       const std::vector<cv::Point> piece(points.begin() + start, points.begin() + i);
       cv::polylines(image, piece, false, colour, thickness, cv::LINE_AA);
@@ -110,8 +108,7 @@ std::array<int, 2> dominantAxes(const AteResult& ate) {
   for (const AteSample& s : ate.samples)
     for (int a = 0; a < 3; ++a) ranges[a].include(s.p_world_gt[a]);
   std::array<int, 3> order = {0, 1, 2};
-  std::sort(order.begin(), order.end(),
-            [&](int a, int b) { return ranges[a].span() > ranges[b].span(); });
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return ranges[a].span() > ranges[b].span(); });
   std::array<int, 2> axes = {order[0], order[1]};
   std::sort(axes.begin(), axes.end());
   return axes;
@@ -131,11 +128,13 @@ void drawTopView(cv::Mat& image, const Panel& frame, const AteResult& ate) {
   Panel panel = frame;
   panel.x = padded(h, 0.05);
   panel.y = padded(v, 0.05);
-  const double metres_per_px = std::max(panel.x.span() / frame.area.width, panel.y.span() / frame.area.height);
+  const double metres_per_px =
+      std::max(panel.x.span() / frame.area.width, panel.y.span() / frame.area.height);
   const double cx = 0.5 * (panel.x.lo + panel.x.hi), cy = 0.5 * (panel.y.lo + panel.y.hi);
   panel.x = {cx - 0.5 * metres_per_px * frame.area.width, cx + 0.5 * metres_per_px * frame.area.width};
   panel.y = {cy - 0.5 * metres_per_px * frame.area.height, cy + 0.5 * metres_per_px * frame.area.height};
-  drawAxes(image, panel, std::string(kAxisNames[axes[0]]) + " [m]", std::string(kAxisNames[axes[1]]) + " [m]");
+  drawAxes(image, panel, std::string(kAxisNames[axes[0]]) + " [m]",
+           std::string(kAxisNames[axes[1]]) + " [m]");
 
   std::vector<cv::Point> gt, est;
   for (const AteSample& s : ate.samples) {

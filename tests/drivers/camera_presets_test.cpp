@@ -1,12 +1,12 @@
 // Camera presets, camera files and the lens model on the presets' real values.
-#include "drivers/dataset/camera_file.h"
 #include "drivers/dataset/camera_presets.h"
-
-#include <cmath>
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "dataset_test_support.h"
+#include "drivers/dataset/camera_file.h"
 
 namespace plumb {
 namespace {

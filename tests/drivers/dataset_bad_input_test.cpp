@@ -1,8 +1,8 @@
 // Every bad dataset input gives one clear Status naming the file (and line), never a crash.
 // The datasets are tiny (8x6 pixels) folders written into a private temp dir.
-#include <opencv2/imgcodecs.hpp>
-
 #include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
 
 #include "dataset_test_support.h"
 #include "drivers/common/open_source.h"
@@ -94,7 +94,8 @@ TEST_F(BadDataset, TheValidFixtureLoads) {
 TEST_F(BadDataset, MissingImageFileIsReportedAtOpen) {
   std::filesystem::remove(file("depth/1.038000.png"));
   std::unique_ptr<TumDatasetSource> source;
-  expectMentions(open(&source), file("depth/1.038000.png"), "missing image file (listed in rgb.txt/depth.txt)");
+  expectMentions(open(&source), file("depth/1.038000.png"),
+                 "missing image file (listed in rgb.txt/depth.txt)");
 }
 
 TEST_F(BadDataset, ImageFileRemovedAfterOpen) {
@@ -197,12 +198,12 @@ TEST_F(BadDataset, BadAssociationsFile) {
   write("associations.txt", "1.000000 rgb/1.000000.png 1.005000\n");
   expectMentions(open(&source), file("associations.txt") + ":1", "got 3 fields");
   write("associations.txt",
-             "1.033333 rgb/1.033333.png 1.038000 depth/1.038000.png\n"
-             "1.000000 rgb/1.000000.png 1.005000 depth/1.005000.png\n");
+        "1.033333 rgb/1.033333.png 1.038000 depth/1.038000.png\n"
+        "1.000000 rgb/1.000000.png 1.005000 depth/1.005000.png\n");
   expectMentions(open(&source), file("associations.txt") + ":2", "non-monotonic rgb");
   write("associations.txt",
-             "1.000000 rgb/1.000000.png 1.005000 depth/1.005000.png\n"
-             "1.033333 rgb/1.033333.png 1.005000 depth/1.005000.png\n");
+        "1.000000 rgb/1.000000.png 1.005000 depth/1.005000.png\n"
+        "1.033333 rgb/1.033333.png 1.005000 depth/1.005000.png\n");
   expectMentions(open(&source), file("associations.txt") + ":2", "duplicate depth");
   write("associations.txt", "# nothing\n");
   expectMentions(open(&source), file("associations.txt"), "empty list");

@@ -1,10 +1,9 @@
 // Property tests: arbitrary bytes in list, trajectory and camera files, and PNGs cut at every
 // length, give a Status (ok or a message naming the file) and never crash or hang.
-#include <random>
+#include <gtest/gtest.h>
 
 #include <opencv2/imgcodecs.hpp>
-
-#include <gtest/gtest.h>
+#include <random>
 
 #include "dataset_test_support.h"
 #include "drivers/dataset/camera_presets.h"

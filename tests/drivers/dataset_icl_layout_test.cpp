@@ -1,8 +1,8 @@
 // ICL-NUIM in TUM format: integer frame-index timestamps, depth-first associations, camera `icl`
 // (negative fy) chosen from the folder name.
-#include <opencv2/imgcodecs.hpp>
-
 #include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
 
 #include "dataset_test_support.h"
 #include "drivers/common/open_source.h"

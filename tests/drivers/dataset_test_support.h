@@ -1,12 +1,12 @@
 #pragma once
 // Helpers for the dataset / trajectory / camera tests: a private temporary folder per test (ctest
 // runs tests in parallel processes) and small file writers for building bad inputs.
+#include <gtest/gtest.h>
+
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
-
-#include <gtest/gtest.h>
 
 namespace plumb::testing {
 
@@ -49,9 +49,9 @@ inline std::string sharedDataset(const std::string& name) {
   return std::filesystem::is_directory(dir) ? dir : "";
 }
 
-#define PLUMB_SKIP_WITHOUT_DATASET(dir, name)                                              \
-  const std::string dir = ::plumb::testing::sharedDataset(name);                           \
-  if (dir.empty())                                                                          \
+#define PLUMB_SKIP_WITHOUT_DATASET(dir, name)                                         \
+  const std::string dir = ::plumb::testing::sharedDataset(name);                      \
+  if (dir.empty())                                                                    \
   GTEST_SKIP() << "shared dataset " << name << " not found under " PLUMB_DATASETS_DIR \
                << " (tests that need real TUM data are skipped)"
 

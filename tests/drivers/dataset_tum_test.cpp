@@ -1,13 +1,12 @@
 // TUM replay on the shared real frames: counts, sizes, timestamps, depth factor, association.
-#include "drivers/dataset/tum_dataset.h"
+#include <gtest/gtest.h>
 
 #include <filesystem>
-
-#include <gtest/gtest.h>
 
 #include "dataset_test_support.h"
 #include "drivers/common/open_source.h"
 #include "drivers/dataset/camera_presets.h"
+#include "drivers/dataset/tum_dataset.h"
 #include "drivers/dataset/tum_lists.h"
 
 namespace plumb {

@@ -1,13 +1,12 @@
 // Evaluation: rigid alignment, the benchmark's association rule, ATE and RPE on synthetic
 // trajectories with known answers, and the two published reference answers.
-#include "drivers/trajectory/evaluate.h"
+#include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
-#include <gtest/gtest.h>
-
 #include "dataset_test_support.h"
+#include "drivers/trajectory/evaluate.h"
 #include "drivers/trajectory/rigid_alignment.h"
 
 namespace plumb {
@@ -150,7 +149,8 @@ TEST(Rpe, ConstantYawDriftGivesItsRate) {
     const double t = p.timestamp - estimate.front().timestamp;
     // The estimate's world frame spins about world z at the drift rate: every relative motion
     // over 1 s is then off by exactly that rotation (conjugated into the camera frame).
-    p.T_world_cam = Eigen::AngleAxisd(drift_deg_per_s * t * M_PI / 180, Eigen::Vector3d::UnitZ()) * p.T_world_cam;
+    p.T_world_cam =
+        Eigen::AngleAxisd(drift_deg_per_s * t * M_PI / 180, Eigen::Vector3d::UnitZ()) * p.T_world_cam;
   }
   RpeResult rpe;
   ASSERT_TRUE(evaluateRpe(gt, estimate, {}, &rpe).ok());

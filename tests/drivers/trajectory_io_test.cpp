@@ -1,9 +1,9 @@
 // TUM trajectory files: round trip, lost-frame markers, deterministic bytes, bad lines.
 #include "drivers/trajectory/trajectory_io.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "dataset_test_support.h"
 

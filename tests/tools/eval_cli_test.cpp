@@ -1,16 +1,14 @@
 // `plumb eval` from the command line: the published answers, JSON output, the plot, and bad input
 // (non-zero exit and a message naming the file).
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <string>
-
 #include <opencv2/imgcodecs.hpp>
-
-#include <gtest/gtest.h>
+#include <string>
 
 namespace {
 
@@ -115,7 +113,8 @@ TEST(EvalCli, CorruptFileExitsNonZeroNamingFileAndLine) {
 TEST(EvalCli, UnrelatedTrajectoriesAreAnErrorNotANumber) {
   ScratchDir dir;
   const std::string gt = dir.write("gt.txt", "1.0 0 0 0 0 0 0 1\n2.0 1 0 0 0 0 0 1\n3.0 2 0 0 0 0 0 1\n");
-  const std::string est = dir.write("est.txt", "71.0 0 0 0 0 0 0 1\n72.0 1 0 0 0 0 0 1\n73.0 2 0 0 0 0 0 1\n");
+  const std::string est =
+      dir.write("est.txt", "71.0 0 0 0 0 0 0 1\n72.0 1 0 0 0 0 0 1\n73.0 2 0 0 0 0 0 1\n");
   const RunResult r = runPlumb("eval --gt " + gt + " --est " + est);
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_EQ(r.output.find("ATE RMSE"), std::string::npos) << r.output;
@@ -124,7 +123,8 @@ TEST(EvalCli, UnrelatedTrajectoriesAreAnErrorNotANumber) {
 TEST(EvalCli, UnwritablePlotIsAnErrorNamingThePath) {
   ScratchDir dir;
   std::string poses;
-  for (int i = 0; i < 40; ++i) poses += std::to_string(1.0 + 0.1 * i) + " " + std::to_string(0.01 * i) + " 0 0 0 0 0 1\n";
+  for (int i = 0; i < 40; ++i)
+    poses += std::to_string(1.0 + 0.1 * i) + " " + std::to_string(0.01 * i) + " 0 0 0 0 0 1\n";
   const std::string gt = dir.write("gt.txt", poses);
   for (const std::string& plot : {dir.file("no_such_folder/plot.png"), dir.file("plot.jpgx")}) {
     const RunResult r = runPlumb("eval --gt " + gt + " --est " + gt + " --plot " + plot);
