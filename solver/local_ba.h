@@ -64,6 +64,8 @@
 
 namespace plumb {
 
+enum class ObservationKind : uint8_t { kStereoPoint, kMonoPoint, kLineSample };
+
 struct LocalBaOptions {
   int max_iterations = 10;  // LM iterations (accepted and rejected steps both count)
   RobustKernelType kernel = RobustKernelType::kPseudoHuber;
@@ -83,6 +85,17 @@ struct LocalBaOptions {
   // Eigenvalues of a 3x3 landmark block below this fraction of its largest one are treated as
   // exact zeros (pseudo-inverse; see DEGENERATE LANDMARKS above).
   double landmark_singular_threshold = 1e-10;
+
+  RobustKernel kernelFor(ObservationKind kind) const {
+    return {kernel, kind == ObservationKind::kStereoPoint ? kernel_delta_stereo
+                    : kind == ObservationKind::kMonoPoint ? kernel_delta_mono
+                                                          : kernel_delta_line};
+  }
+  double chi2ThresholdFor(ObservationKind kind) const {
+    return kind == ObservationKind::kStereoPoint ? chi2_stereo
+           : kind == ObservationKind::kMonoPoint ? chi2_mono
+                                                 : chi2_line;
+  }
 };
 
 enum class LocalBaStatus {
@@ -104,8 +117,6 @@ struct LocalBaSummary {
 };
 
 const char* toString(LocalBaStatus status);
-
-enum class ObservationKind : uint8_t { kStereoPoint, kMonoPoint, kLineSample };
 
 class LocalBundleAdjuster {
  public:

@@ -1,0 +1,132 @@
+// LocalBundleAdjuster, outer loop: Levenberg-Marquardt step control, costs, outlier flags and
+// the covariance of the optimised poses.
+#include <algorithm>
+#include <cmath>
+
+#include "solver/dense_cholesky.h"
+#include "solver/local_ba.h"
+#include "solver/se3.h"
+
+namespace plumb {
+
+// Robust cost at the candidate estimate over the observations valid at the linearisation point.
+// *all_valid turns false when the candidate moves one of them behind its camera.
+double LocalBundleAdjuster::candidateCost(const LocalBaOptions& options, bool* all_valid) const {
+  double cost = 0.0;
+  *all_valid = true;
+  for (int k = 0; k < num_observations_; ++k) {
+    const Observation& obs = observations_[k];
+    if (!obs.valid) continue;
+    double chi2 = 0.0;
+    if (!evaluateChi2(obs, keyframes_[obs.keyframe].T_candidate, landmarks_[obs.landmark].P_candidate, &chi2)) {
+      *all_valid = false;
+      return cost;
+    }
+    cost += 0.5 * evaluateKernel(options.kernelFor(obs.kind), chi2).rho;
+  }
+  return cost;
+}
+
+double LocalBundleAdjuster::cost(const LocalBaOptions& options) const {
+  double cost = 0.0;
+  for (int k = 0; k < num_observations_; ++k) {
+    const Observation& obs = observations_[k];
+    double chi2 = 0.0;
+    if (!obs.enabled ||
+        !evaluateChi2(obs, keyframes_[obs.keyframe].T_cam_world, landmarks_[obs.landmark].P_world, &chi2))
+      continue;
+    cost += 0.5 * evaluateKernel(options.kernelFor(obs.kind), chi2).rho;
+  }
+  return cost;
+}
+
+void LocalBundleAdjuster::updateOutlierFlags(const LocalBaOptions& options, LocalBaSummary* summary) {
+  summary->num_outliers = 0;
+  for (int k = 0; k < num_observations_; ++k) {
+    Observation& obs = observations_[k];
+    if (!obs.enabled) {
+      obs.outlier = false;
+      continue;
+    }
+    const bool in_front =
+        evaluateChi2(obs, keyframes_[obs.keyframe].T_cam_world, landmarks_[obs.landmark].P_world, &obs.chi2);
+    obs.outlier = !in_front || obs.chi2 > options.chi2ThresholdFor(obs.kind);
+    summary->num_outliers += obs.outlier ? 1 : 0;
+  }
+}
+
+LocalBaSummary LocalBundleAdjuster::solve(const LocalBaOptions& options) {
+  LocalBaSummary summary;
+  covariance_valid_ = false;
+  if (num_pose_variables_ == 0 && num_landmarks_ == 0) return summary;
+  buildStructure();
+  double cost = linearize(options);
+  summary.initial_cost = cost;
+  summary.status = LocalBaStatus::kMaxIterations;
+  double radius = options.initial_trust_radius;
+  double decrease_factor = 2.0;
+  bool relinearize = false;
+  for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
+    if (relinearize) cost = linearize(options);
+    relinearize = false;
+    const double lambda = 1.0 / radius;
+    ++summary.iterations;
+    bool step_ok = solveDamped(options, lambda);
+    bool all_valid = false;
+    double new_cost = cost;
+    double predicted = 0.0;
+    if (step_ok) {
+      for (int i = 0; i < num_keyframes_; ++i) {
+        Keyframe& kf = keyframes_[i];
+        kf.T_candidate = kf.variable >= 0 ? applyLeftIncrement(kf.step, kf.T_cam_world) : kf.T_cam_world;
+      }
+      for (int j = 0; j < num_landmarks_; ++j) landmarks_[j].P_candidate = landmarks_[j].P_world + landmarks_[j].step;
+      new_cost = candidateCost(options, &all_valid);
+      predicted = modelCostReduction(lambda);
+    }
+    const double actual = cost - new_cost;
+    const double step_quality = predicted > 0.0 ? actual / predicted : -1.0;
+    if (step_ok && all_valid && std::isfinite(new_cost) && step_quality > options.min_relative_decrease) {
+      for (int i = 0; i < num_keyframes_; ++i) keyframes_[i].T_cam_world = keyframes_[i].T_candidate;
+      for (int j = 0; j < num_landmarks_; ++j) landmarks_[j].P_world = landmarks_[j].P_candidate;
+      const double grow = 1.0 - std::pow(2.0 * step_quality - 1.0, 3);
+      radius = std::min(options.max_trust_radius, radius / std::max(1.0 / 3.0, grow));
+      decrease_factor = 2.0;
+      ++summary.successful_steps;
+      relinearize = true;
+      const double relative_change = actual / std::max(cost, 1e-300);
+      cost = new_cost;
+      if (relative_change < options.function_tolerance) {
+        summary.status = LocalBaStatus::kConverged;
+        break;
+      }
+    } else {
+      radius /= decrease_factor;
+      decrease_factor *= 2.0;
+    }
+  }
+  summary.final_cost = cost;
+  summary.num_fixed_landmarks = num_fixed_landmarks_;
+  updateOutlierFlags(options, &summary);
+  return summary;
+}
+
+bool LocalBundleAdjuster::computeStep(const LocalBaOptions& options, double lambda) {
+  buildStructure();
+  linearize(options);
+  return solveDamped(options, lambda);
+}
+
+bool LocalBundleAdjuster::computeCovariance(const LocalBaOptions& options) {
+  covariance_valid_ = false;
+  buildStructure();
+  linearize(options);
+  // lambda = 0: the undamped reduced system S = H_A - H_B H_C^-1 H_B^T, factorised in place.
+  if (!solveDamped(options, 0.0)) return false;
+  const Eigen::Index dim = 6 * static_cast<Eigen::Index>(num_pose_variables_);
+  choleskyInverse(S_.topLeftCorner(dim, dim), covariance_.topLeftCorner(dim, dim));
+  covariance_valid_ = covariance_.topLeftCorner(dim, dim).allFinite();
+  return covariance_valid_;
+}
+
+}  // namespace plumb
