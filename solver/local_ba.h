@@ -5,6 +5,8 @@
 // L landmarks P_world (3-dof; map points and line-guidance points alike). Fixed keyframes
 // contribute residuals but no variables: they hold the gauge. Without any fixed keyframe the
 // problem has a 6-dof gauge freedom; LM damping still gives steps, but covariance() then fails.
+// Line samples carry no depth: a window constrained by lines alone also needs a second fixed
+// keyframe to fix its scale.
 //
 // COST. 0.5 * sum_obs rho(e^T Omega e) with the factors of solver/factors.h (stereo [u,v,u_r],
 // mono [u,v], line sample l^T pi(T P)) and the kernels of solver/robust_kernel.h. Each iteration
@@ -25,7 +27,8 @@
 //   dx_l_j = -H_jj^-1 (g_l_j + sum_i W_ij^T dx_p_i)        (back-substitution per landmark)
 //
 // S is dense 6K x 6K (every pair of keyframes sharing a landmark couples) and small (60 x 60 for
-// K = 10), so it is factorised by a dense in-place Cholesky (solver/dense_cholesky.h).
+// K = 10), so it is factorised by a dense in-place Cholesky (solver/dense_cholesky.h). Only its
+// lower block triangle is formed: each unordered pair of a landmark's observations once.
 //
 // LEVENBERG-MARQUARDT. The damped system adds lambda * clamp(diag(H), 1e-6, 1e32) to the diagonal
 // of BOTH H_pp and H_ll before elimination (Ceres' schedule: lambda = 1 / trust radius, radius
@@ -51,8 +54,9 @@
 // computeCovariance() and computeStep() never touch the heap (proved by a test hooking operator
 // new). Buffers: per keyframe (pose, 6x6 H_pp block, g_p, pose step), per landmark (point,
 // 3x3 H_ll, its Cholesky inverse, g_l, step, first-observation offset), per observation (kind,
-// z, Omega, W_ij = J_pose^T w Omega J_point, V_ij = W_ij H_jj^-1, chi2), one dense S and one
-// dense covariance of the maximal 6K x 6K size, used through their top-left corners.
+// z, Omega, W_ij = J_pose^T w Omega J_point, V_ij = W_ij H_jj^-1, chi2), the landmark-major
+// observation order plus one landmark's scratch list, one dense S and one dense covariance of
+// the maximal 6K x 6K size, used through their top-left corners.
 #include <cstdint>
 #include <vector>
 
