@@ -67,6 +67,50 @@ TEST(PoseOptimizer, RecoversAPerturbedPoseAndClassifiesOutliers) {
   }
 }
 
+// The point-space accumulation against the plain path: H = sum J^T (w Omega) J over the final
+// inliers, with the factors' own pose Jacobians; the covariance must be its inverse.
+TEST(PoseOptimizer, CovarianceIsTheInverseOfTheInlierHessian) {
+  const PoseProblem p = makePoseProblem(45, 200, 20, 0.1);
+  Vector6d delta;
+  delta << 0.02, -0.01, 0.03, -0.01, 0.02, 0.01;
+  std::unique_ptr<bool[]> point_inliers(new bool[p.points.size()]);
+  std::unique_ptr<bool[]> line_inliers(new bool[p.lines.size()]);
+  const PoseOptimizerOptions options;
+  const PoseResult result = optimizePose(p.camera, applyLeftIncrement(delta, p.T_cam_world_true), p.points.data(),
+                                         static_cast<int>(p.points.size()), p.lines.data(),
+                                         static_cast<int>(p.lines.size()), options, point_inliers.get(),
+                                         line_inliers.get());
+  ASSERT_TRUE(result.covariance_valid);
+  Matrix6d H = Matrix6d::Zero();
+  for (size_t i = 0; i < p.points.size(); ++i) {
+    if (!point_inliers[i]) continue;
+    const PosePointObservation& obs = p.points[i];
+    if (obs.has_depth) {
+      Eigen::Vector3d e;
+      Matrix36d J;
+      ASSERT_TRUE(evaluateStereoPoint(p.camera, result.T_cam_world, obs.P_world, obs.z, &e, &J, nullptr));
+      const double w = evaluateKernel({options.kernel, options.kernel_delta_stereo}, e.dot(obs.information * e)).rho1;
+      H += J.transpose() * (w * obs.information) * J;
+    } else {
+      Eigen::Vector2d e;
+      Matrix26d J;
+      ASSERT_TRUE(evaluateMonoPoint(p.camera, result.T_cam_world, obs.P_world, obs.z.head<2>(), &e, &J, nullptr));
+      const Eigen::Matrix2d omega = obs.information.topLeftCorner<2, 2>();
+      const double w = evaluateKernel({options.kernel, options.kernel_delta_mono}, e.dot(omega * e)).rho1;
+      H += J.transpose() * (w * omega) * J;
+    }
+  }
+  for (size_t i = 0; i < p.lines.size(); ++i) {
+    if (!line_inliers[i]) continue;
+    double e = 0.0;
+    RowVector6d J;
+    ASSERT_TRUE(evaluateLineSample(p.camera, result.T_cam_world, p.lines[i].P_world, p.lines[i].line, &e, &J, nullptr));
+    const double w = evaluateKernel({options.kernel, options.kernel_delta_line}, e * e * p.lines[i].information).rho1;
+    H += J.transpose() * (w * p.lines[i].information) * J;
+  }
+  EXPECT_LT((result.covariance * H - Matrix6d::Identity()).norm(), 1e-9);
+}
+
 // More observations of the same quality cannot make the pose less certain.
 TEST(PoseOptimizer, CovarianceShrinksWithMoreObservations) {
   const PoseProblem p = makePoseProblem(42, 400, 0, 0.0);
