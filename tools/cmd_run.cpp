@@ -30,8 +30,10 @@ void printRunUsage() {
       "  --gt FILE            ground truth (TUM format): print the ATE RMSE (synthetic scenes: exact)\n"
       "  --synth-noise        synthetic scenes with Kinect-like depth and pixel noise\n"
       "  --output-delay N     frames held back so local BA refines them (default 60; 0 = as tracked)\n"
-      "  --rss-every N        record peak RSS every N frames in the statistics\n"
-      "  --progress           a progress line every 100 frames on stderr\n");
+      "  --rss-every N        record peak RSS every N frames in the statistics (poses are then not\n"
+      "                       kept in memory: no synthetic ATE unless --gt is given)\n"
+      "  --progress           a progress line every 100 frames on stderr\n"
+      "  --trace              one line per frame on stderr: matches, inliers, keyframe, pose\n");
 }
 
 int fail(const std::string& message) {
@@ -43,7 +45,7 @@ int runRun(int argc, char** argv) {
   Args args(argc, argv,
             {"dataset", "camera", "out", "line-samples", "covariance", "stats", "max-frames", "gt",
              "output-delay", "rss-every"},
-            {"no-lines", "synth-noise", "progress"});
+            {"no-lines", "synth-noise", "progress", "trace"});
   if (args.help()) {
     printRunUsage();
     return 0;
@@ -92,8 +94,10 @@ int runRun(int argc, char** argv) {
   options.max_frames = max_frames;
   options.rss_every = rss_every;
   options.progress = args.has("progress");
-  // Only the ATE needs the poses in memory; long runs without it stay flat.
-  options.keep_trajectory = args.has("gt") || scene != nullptr;
+  options.trace = args.has("trace");
+  // Only the ATE needs the poses in memory. A memory-profiling run (--rss-every) keeps nothing
+  // per frame, so its resident size can stay flat; it reports no ATE for synthetic scenes.
+  options.keep_trajectory = args.has("gt") || (scene != nullptr && rss_every == 0);
 
   SessionResult result;
   Status st = runSession(*source, options, &result);

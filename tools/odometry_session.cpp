@@ -124,7 +124,7 @@ Status runSession(FrameSource& source, const SessionOptions& options, SessionRes
       c.frame = result->frames;
       if (readRss(&c.peak_rss_kib, &c.current_rss_kib)) result->rss.push_back(c);
     }
-    if (std::getenv("PLUMB_DEBUG") != nullptr) {
+    if (options.trace) {
       const Eigen::Vector3d t = out.T_world_cam.translation();
       std::fprintf(stderr, "%ld %s fm %d lm %d pi %d li %d lmi %d kf %d np %d nl %d reloc %d fb %d t %.3f %.3f %.3f\n",
                    result->frames, toString(out.state), out.track.frame_matches, out.track.local_map_matches,
@@ -265,6 +265,10 @@ Status ateRmse(const std::vector<StampedPose>& ground_truth, const std::vector<S
 
 void setLineOptions(int line_samples, bool use_lines, SystemOptions* options) {
   options->odometry.extractor.line_samples = line_samples;
+  // A 3D line fit needs min_line_inliers samples (default 3): with fewer samples per line, every
+  // sample must be an inlier, or N = 1, 2 would silently mean "no lines".
+  options->odometry.extractor.min_line_inliers =
+      std::max(1, std::min(options->odometry.extractor.min_line_inliers, line_samples));
   // No samples means nothing for lines to contribute: the points-only system.
   options->odometry.tracker.use_lines = use_lines && line_samples > 0;
 }

@@ -24,6 +24,7 @@ struct SessionOptions {
   bool keep_trajectory = true;  // keep poses in memory (for ATE); off for very long runs
   long rss_every = 0;           // > 0: sample the peak RSS every this many frames
   bool progress = false;        // a line per 100 frames on stderr
+  bool trace = false;           // a line per frame on stderr (matches, inliers, keyframes, pose)
 };
 
 // Per-frame cost in a fixed histogram (0.05 ms bins up to 500 ms), so long runs need no memory.
