@@ -111,7 +111,7 @@ int runRun(int argc, char** argv) {
   } else if (scene != nullptr) {
     ground_truth = syntheticGroundTruth(*scene, result.frames);
   }
-  if (!ground_truth.empty()) {
+  if (!ground_truth.empty() && options.keep_trajectory) {
     st = ateRmse(ground_truth, result.trajectory, &ate);
     if (!st.ok()) std::fprintf(stderr, "plumb run: no ATE: %s\n", st.message().c_str());
   }
