@@ -1,14 +1,18 @@
 // plumb run: the odometry system over a dataset folder or a synthetic scene, writing the
 // trajectory (TUM format, lost frames as `# <timestamp> lost`), optionally keyframe covariances
 // and statistics, and the ATE when ground truth is at hand. Same input -> same output bytes.
+// Single-threaded by default; --mode runs the same system as runtime stages (tools/staged_run.h),
+// where deterministic and fast give the single-threaded bytes and realtime may drop frames.
 #include <cstdio>
 #include <memory>
+#include <set>
 #include <string>
 
 #include "drivers/common/open_source.h"
 #include "tools/args.h"
 #include "tools/command.h"
 #include "tools/odometry_session.h"
+#include "tools/staged_run.h"
 
 namespace plumb::tools {
 namespace {
@@ -33,7 +37,17 @@ void printRunUsage() {
       "  --rss-every N        record peak RSS every N frames in the statistics (poses are then not\n"
       "                       kept in memory: no synthetic ATE unless --gt is given)\n"
       "  --progress           a progress line every 100 frames on stderr\n"
-      "  --trace              one line per frame on stderr: matches, inliers, keyframe, pose\n");
+      "  --trace              one line per frame on stderr: matches, inliers, keyframe, pose\n"
+      "  --count-allocations  print heap allocations per frame after a 30-frame warm-up\n"
+      "staged pipeline (capture -> extract -> odometry, docs/RUNTIME.md); without --mode the run is\n"
+      "single-threaded and the options below are refused:\n");
+  std::printf("%s", stagedRunUsage());
+}
+
+// The option sets of `plumb run`: its own plus the staged-pipeline ones.
+std::set<std::string> withStagedOptions(std::set<std::string> own, const std::set<std::string>& staged) {
+  own.insert(staged.begin(), staged.end());
+  return own;
 }
 
 int fail(const std::string& message) {
@@ -43,9 +57,11 @@ int fail(const std::string& message) {
 
 int runRun(int argc, char** argv) {
   Args args(argc, argv,
-            {"dataset", "camera", "out", "line-samples", "covariance", "stats", "max-frames", "gt",
-             "output-delay", "rss-every"},
-            {"no-lines", "synth-noise", "progress", "trace"});
+            withStagedOptions({"dataset", "camera", "out", "line-samples", "covariance", "stats", "max-frames",
+                               "gt", "output-delay", "rss-every"},
+                              stagedRunValueOptions()),
+            withStagedOptions({"no-lines", "synth-noise", "progress", "trace", "count-allocations"},
+                              stagedRunFlagOptions()));
   if (args.help()) {
     printRunUsage();
     return 0;
@@ -69,6 +85,20 @@ int runRun(int argc, char** argv) {
   }
   if (output_delay < 0 || output_delay >= OdometryTrajectory::kMaxDelayFrames) {
     return fail("--output-delay must be within 0.." + std::to_string(OdometryTrajectory::kMaxDelayFrames - 1));
+  }
+
+  // Staged options only mean something with --mode; refusing them keeps a typo'd run from silently
+  // being single-threaded.
+  StagedRunOptions staged;
+  if (args.has("mode")) {
+    const Status st = parseStagedRunOptions(args, &staged);
+    if (!st.ok()) return fail(st.message());
+  } else {
+    for (const auto* names : {&stagedRunValueOptions(), &stagedRunFlagOptions()}) {
+      for (const std::string& name : *names) {
+        if (args.has(name)) return fail("--" + name + " needs --mode realtime|fast|deterministic");
+      }
+    }
   }
 
   const std::string spec = args.get("dataset");
@@ -95,6 +125,9 @@ int runRun(int argc, char** argv) {
   options.rss_every = rss_every;
   options.progress = args.has("progress");
   options.trace = args.has("trace");
+  options.use_stages = args.has("mode");
+  options.staged = staged;
+  options.count_allocations = args.has("count-allocations");
   // Only the ATE needs the poses in memory. A memory-profiling run (--rss-every) keeps nothing
   // per frame, so its resident size can stay flat; it reports no ATE for synthetic scenes.
   options.keep_trajectory = args.has("gt") || (scene != nullptr && rss_every == 0);
@@ -126,6 +159,24 @@ int runRun(int argc, char** argv) {
   std::printf("ms per frame: mean %.2f, p99 %.2f (extract %.2f, track %.2f, map %.2f mean)\n",
               result.total_ms.mean(), result.total_ms.percentile(99), result.extract_ms.mean(),
               result.track_ms.mean(), result.map_ms.mean());
+  if (options.use_stages) {
+    // Extraction runs on its own stage there, so the per-frame extract time above reads 0.
+    const runtime::RunReport& report = result.staged.report;
+    std::printf("staged %s: %.1f frames/s, dropped %llu, late %llu, extraction failures %llu\n",
+                runtime::runModeName(options.staged.mode), report.framesPerSecond(),
+                (unsigned long long)report.frames_dropped, (unsigned long long)report.frames_late,
+                (unsigned long long)result.staged.extraction_failures);
+  }
+  if (options.count_allocations) {
+    if (result.allocation_frames == 0) {
+      std::printf("allocations: run not longer than the %llu-frame warm-up\n",
+                  (unsigned long long)options.staged.warmup_frames);
+    } else {
+      std::printf("allocations after warm-up: %llu over %llu frames (%.2f per frame)\n",
+                  (unsigned long long)result.allocations_after_warmup, (unsigned long long)result.allocation_frames,
+                  double(result.allocations_after_warmup) / double(result.allocation_frames));
+    }
+  }
   if (ate >= 0) std::printf("ATE RMSE %.4f m\n", ate);
   if (args.has("stats")) {
     std::FILE* f = std::fopen(args.get("stats").c_str(), "w");

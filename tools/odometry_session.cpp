@@ -7,6 +7,8 @@
 #include <cstring>
 #include <memory>
 
+#include "platform/allocation_counter.h"
+
 namespace plumb::tools {
 
 void MsHistogram::add(double ms) {
@@ -104,13 +106,10 @@ Status runSession(FrameSource& source, const SessionOptions& options, SessionRes
   };
   auto on_keyframe = [&](const RetiredKeyframe& kf) { covariance_writer.write(kf); };
 
-  RgbdImage image;
-  while (options.max_frames < 0 || result->frames < options.max_frames) {
-    const SourceResult r = source.next(image);
-    if (r == SourceResult::kEndOfStream) break;
-    if (r == SourceResult::kNoFrame) continue;
-    if (r == SourceResult::kError) return source.lastError().withContext(source.describe());
-    const FrameOutput& out = system->processImage(image);
+  // Bookkeeping after each frame, identical for the single-threaded loop and the staged run (where
+  // it runs on the odometry stage's thread, in frame order): statistics, drained output, checks.
+  uint64_t allocations_at_warmup = 0;
+  auto after_frame = [&](const FrameOutput& out) -> Status {
     ++result->frames;
     result->extract_ms.add(out.extract_ms);
     result->track_ms.add(out.track_ms);
@@ -135,6 +134,32 @@ Status runSession(FrameSource& source, const SessionOptions& options, SessionRes
     if (options.progress && result->frames % 100 == 0) {
       std::fprintf(stderr, "frame %ld: %s, keyframes %" PRIu64 ", lost %" PRIu64 "\n", result->frames,
                    toString(out.state), system->stats().keyframes, system->stats().frames_lost);
+    }
+    // Last, so the count covers everything a frame costs, this bookkeeping included.
+    if (options.count_allocations) {
+      const uint64_t frames = uint64_t(result->frames);
+      const uint64_t now = allocationCount();
+      if (frames == options.staged.warmup_frames) allocations_at_warmup = now;
+      if (frames > options.staged.warmup_frames) {
+        result->allocation_frames = frames - options.staged.warmup_frames;
+        result->allocations_after_warmup = now - allocations_at_warmup;
+      }
+    }
+    return Status::Ok();
+  };
+
+  if (options.use_stages) {
+    StagedRunOptions staged = options.staged;
+    staged.max_frames = options.max_frames;
+    PLUMB_RETURN_IF_ERROR(runStaged(source, *system, staged, after_frame, &result->staged));
+  } else {
+    RgbdImage image;
+    while (options.max_frames < 0 || result->frames < options.max_frames) {
+      const SourceResult r = source.next(image);
+      if (r == SourceResult::kEndOfStream) break;
+      if (r == SourceResult::kNoFrame) continue;
+      if (r == SourceResult::kError) return source.lastError().withContext(source.describe());
+      PLUMB_RETURN_IF_ERROR(after_frame(system->processImage(image)));
     }
   }
   system->finish(on_frame, on_keyframe);

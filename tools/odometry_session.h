@@ -13,6 +13,7 @@
 #include "drivers/trajectory/trajectory_io.h"
 #include "pipeline/odometry_system.h"
 #include "platform/status.h"
+#include "tools/staged_run.h"
 
 namespace plumb::tools {
 
@@ -25,6 +26,12 @@ struct SessionOptions {
   long rss_every = 0;           // > 0: sample the peak RSS every this many frames
   bool progress = false;        // a line per 100 frames on stderr
   bool trace = false;           // a line per frame on stderr (matches, inliers, keyframes, pose)
+  // false: the single-threaded processImage() loop. true: capture -> extract -> odometry as runtime
+  // stages (tools/staged_run.h) in staged.mode; the per-frame bookkeeping is the same either way.
+  bool use_stages = false;
+  StagedRunOptions staged;      // max_frames is taken from max_frames above
+  // Count process-wide heap allocations from frame staged.warmup_frames (default 30) to the last.
+  bool count_allocations = false;
 };
 
 // Per-frame cost in a fixed histogram (0.05 ms bins up to 500 ms), so long runs need no memory.
@@ -59,6 +66,11 @@ struct SessionResult {
   MapCounts final_counts;
   std::vector<RssCheckpoint> rss;
   std::string source;
+  // count_allocations: operator new calls between the end of the warm-up frame and the end of the
+  // last frame, over that many frames (0 when the run was not longer than the warm-up).
+  uint64_t allocation_frames = 0;
+  uint64_t allocations_after_warmup = 0;
+  StagedRunResult staged;  // use_stages: latency report, extraction failures
 };
 
 Status runSession(FrameSource& source, const SessionOptions& options, SessionResult* result);

@@ -208,9 +208,9 @@ const std::set<std::string>& stagedRunFlagOptions() {
 }
 
 const char* stagedRunUsage() {
-  return "  --mode M             deterministic (lock-step, default), fast (a thread per stage, no\n"
-         "                       drops) or realtime (threads, paced to the recorded timestamps, a\n"
-         "                       frame finding no free slot is dropped and counted)\n"
+  return "  --mode M             deterministic (stages in lock-step on one thread), fast (a thread\n"
+         "                       per stage, no drops) or realtime (threads, paced to the recorded\n"
+         "                       timestamps, a frame finding no free slot is dropped and counted)\n"
          "  --profile FILE       write a Chrome trace (Perfetto / chrome://tracing) and print\n"
          "                       p50/p90/p99/max per stage and end to end, drops, frames/s\n"
          "  --slots N            frame slots in flight (default 4)\n"
