@@ -98,13 +98,12 @@ TrackResult Tracker::track(const FrameFeatures& frame, uint64_t sequence, double
   }
   result.frame_matches = matches;
 
-  // 2. Pose from the last frame's matches. The optimisation starts from the last pose, not the
-  // prediction: started from the prediction, the pose-only solution leaned towards it, and the
-  // constant-velocity loop amplified that lean until tracking diverged (measured on the synthetic
-  // scenes; the prediction still places the matching windows).
+  // 2. Pose from the last frame's matches, optimised from the prediction. (The lean towards the
+  // start once seen here was the start's drift off SO(3) surviving the optimisation; optimizePose
+  // now projects its start onto SO(3), so the converged pose no longer depends on the start.)
   Eigen::Isometry3d T_cam_world = T_cam_world_pred;
   if (matches >= 6) {
-    const PoseResult pose = optimizeAndPrune(frame, T_cam_world_last, &result);
+    const PoseResult pose = optimizeAndPrune(frame, T_cam_world_pred, &result);
     T_cam_world = pose.T_cam_world;
   }
 

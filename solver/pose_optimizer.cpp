@@ -1,6 +1,7 @@
 #include "solver/pose_optimizer.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/SVD>
 
 #include "solver/factors.h"
 #include "solver/se3.h"
@@ -199,6 +200,17 @@ int classify(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_cam_worl
   return changed;
 }
 
+// The rotation nearest to `linear` in the Frobenius norm (U V^T of its SVD, reflection removed).
+// Poses composed over many frames (velocity * last pose, keyframe * relative pose) drift off SO(3)
+// by ~1e-5; left increments cannot remove that shear, so without this projection the optimum
+// would depend on the start's shear, i.e. the result would lean towards the start.
+Eigen::Matrix3d nearestRotation(const Eigen::Matrix3d& linear) {
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(linear, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d U = svd.matrixU();
+  if ((U * svd.matrixV().transpose()).determinant() < 0.0) U.col(2) = -U.col(2);
+  return U * svd.matrixV().transpose();
+}
+
 }  // namespace
 
 PoseResult optimizePose(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_cam_world_initial,
@@ -210,6 +222,7 @@ PoseResult optimizePose(const CameraIntrinsics& camera, const Eigen::Isometry3d&
                         {options.kernel, options.kernel_delta_line}};
   PoseResult result;
   result.T_cam_world = T_cam_world_initial;
+  result.T_cam_world.linear() = nearestRotation(T_cam_world_initial.linear());
   for (int i = 0; i < num_points; ++i) point_inliers[i] = true;
   for (int i = 0; i < num_lines; ++i) line_inliers[i] = true;
 
