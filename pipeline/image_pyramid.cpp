@@ -1,6 +1,7 @@
 #include "pipeline/image_pyramid.h"
 
 #include <cmath>
+#include <utility>
 
 #include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
@@ -18,6 +19,13 @@ ImagePyramid::ImagePyramid(int width, int height, int num_levels, float scale_fa
     total_rows += sizes[i].height;
   }
   row_filtered_.create(1, width + 6, CV_16UC1);  // one padded row
+  row_pair_.create(2, width, CV_32SC1);
+  for (int i = 1; i < num_levels_; ++i) {
+    x_tap_start_[i] = static_cast<int>(x_taps_.size());
+    appendTaps(sizes[i - 1].width, sizes[i].width, x_taps_);
+    y_tap_start_[i] = static_cast<int>(y_taps_.size());
+    appendTaps(sizes[i - 1].height, sizes[i].height, y_taps_);
+  }
   const cv::Mat kernel = cv::getGaussianKernel(7, 2.0, CV_64F);
   int sum = 0;
   for (int k = 0; k < 7; ++k) sum += kernel_[k] = static_cast<int>(std::lround(kernel.at<double>(k) * 256));
@@ -39,11 +47,67 @@ void ImagePyramid::build(const cv::Mat& grey) {
   grey.copyTo(levels_[0]);  // levels_[0] has the right size: copyTo writes in place
   for (int i = 1; i < num_levels_; ++i) {
     // Resize from the previous level (as ORB-SLAM does): cheap, and the 1.2 step keeps
-    // bilinear aliasing small. dst already has its size, so OpenCV writes into the ROI.
-    cv::resize(levels_[i - 1], levels_[i], levels_[i].size(), 0, 0, cv::INTER_LINEAR);
+    // bilinear aliasing small.
+    downsample(i);
   }
   // 7x7, sigma 2: the smoothing rotated BRIEF is defined on.
   for (int i = 0; i < num_levels_; ++i) blur(levels_[i], blurred_levels_[i]);
+}
+
+void ImagePyramid::appendTaps(int src_size, int dst_size, std::vector<Tap>& taps) {
+  const double step = static_cast<double>(src_size) / dst_size;
+  for (int d = 0; d < dst_size; ++d) {
+    const double f = (d + 0.5) * step - 0.5;  // source coordinate of the destination pixel centre
+    int index = static_cast<int>(std::floor(f));
+    double fraction = f - index;
+    if (index < 0) index = 0, fraction = 0;
+    if (index >= src_size - 1) index = src_size - 1, fraction = 0;
+    const int weight = static_cast<int>(std::lround(fraction * (1 << kWeightBits)));
+    taps.push_back({index, index + 1 < src_size ? index + 1 : index, weight});
+  }
+}
+
+void ImagePyramid::downsample(int level) {
+  const cv::Mat& src = levels_[level - 1];
+  cv::Mat& dst = levels_[level];
+  const Tap* x_taps = x_taps_.data() + x_tap_start_[level];
+  const Tap* y_taps = y_taps_.data() + y_tap_start_[level];
+  const int one = 1 << kWeightBits;
+  // Horizontal pass into 32-bit rows (value * 2048), cached: with a 1.2 step most source rows
+  // feed two destination rows, so the pair is reused or shifted instead of recomputed.
+  int* rows[2] = {row_pair_.ptr<int>(0), row_pair_.ptr<int>(1)};
+  int cached[2] = {-1, -1};
+  auto sampleRow = [&](int src_row, int* out) {
+    const uint8_t* p = src.ptr<uint8_t>(src_row);
+    for (int x = 0; x < dst.cols; ++x) {
+      const Tap& t = x_taps[x];
+      out[x] = p[t.index0] * (one - t.weight) + p[t.index1] * t.weight;
+    }
+  };
+  for (int y = 0; y < dst.rows; ++y) {
+    const Tap& ty = y_taps[y];
+    if (cached[0] != ty.index0) {
+      if (cached[1] == ty.index0) {
+        std::swap(rows[0], rows[1]);
+        std::swap(cached[0], cached[1]);
+      } else {
+        sampleRow(ty.index0, rows[0]);
+        cached[0] = ty.index0;
+      }
+    }
+    if (cached[1] != ty.index1) {
+      sampleRow(ty.index1, rows[1]);
+      cached[1] = ty.index1;
+    }
+    // Vertical pass: 255 * 2048 * 2048 + rounding still fits a signed 32-bit int.
+    uint8_t* d = dst.ptr<uint8_t>(y);
+    const int w1 = ty.weight, w0 = one - w1;
+    const int* r0 = rows[0];
+    const int* r1 = rows[1];
+    for (int x = 0; x < dst.cols; ++x) {
+      d[x] = static_cast<uint8_t>((r0[x] * w0 + r1[x] * w1 + (1 << (2 * kWeightBits - 1))) >> (2 * kWeightBits));
+    }
+  }
 }
 
 void ImagePyramid::blur(const cv::Mat& src, cv::Mat& dst) {

@@ -2,14 +2,15 @@
 // ImagePyramid: the grey image at num_levels scales (level i is 1/scale^i of level 0) plus a
 // Gaussian-blurred copy of every level for the binary descriptors.
 //
-// Allocation: the blur is our own separable filter (cv::GaussianBlur builds a filter engine, ~10
-// heap allocations per call); cv::resize is kept (SIMD, and it makes exactly 2 small allocations
-// per call, measured by tests/pipeline/allocation_test.cpp and documented in docs/FRONTEND.md).
+// Allocation: build() allocates nothing. The blur is our own separable filter (cv::GaussianBlur
+// builds a filter engine, ~10 heap allocations per call) and so is the bilinear downsampler
+// (cv::resize allocates 2-3 small buffers per call); its sampling tables are built once here.
 //
 // All levels live as ROIs of ONE buffer whose row stride is level 0's width, so a pixel offset
 // (dy * stride + dx) means the same thing on every level: the rotated-BRIEF and FAST offset
 // tables are computed once. Buffers are allocated in the constructor; build() only writes.
 #include <array>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -34,6 +35,20 @@ class ImagePyramid {
   int num_levels_;
   std::array<float, kPyramidLevels> scales_{};
   void blur(const cv::Mat& src, cv::Mat& dst);
+  void downsample(int level);  // levels_[level - 1] -> levels_[level], bilinear
+
+  // Bilinear sampling table of one axis of one level: source index and the 11-bit fixed-point
+  // weight of index + 1 (weight of index is 2048 - that). Same half-pixel-centre convention as
+  // cv::resize INTER_LINEAR, so the pyramid is close to what OpenCV would give.
+  struct Tap {
+    int index0, index1;  // index1 = index0 + 1, clamped to the last pixel
+    int weight;          // of index1, in 1/2048
+  };
+  static constexpr int kWeightBits = 11;
+  static void appendTaps(int src_size, int dst_size, std::vector<Tap>& taps);
+  std::vector<Tap> x_taps_, y_taps_;                          // all levels, concatenated
+  std::array<int, kPyramidLevels> x_tap_start_{}, y_tap_start_{};  // each level's first entry
+  cv::Mat row_pair_;                // CV_32SC1, 2 rows: the two horizontally sampled source rows
 
   cv::Mat buffer_, blurred_buffer_;
   cv::Mat row_filtered_;            // CV_16UC1, one row + 3 px padding each side: the blur's vertical pass
