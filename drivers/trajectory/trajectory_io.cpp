@@ -92,19 +92,27 @@ Status readTumTrajectory(const std::string& path, std::vector<StampedPose>* out,
   return Status::Ok();
 }
 
-std::string formatTumLine(const StampedPose& pose) {
-  char text[256];
+std::size_t formatTumLine(const StampedPose& pose, char* buffer, std::size_t buffer_size) {
+  if (buffer_size == 0) return 0;
+  int written = 0;
   if (!pose.valid) {
-    std::snprintf(text, sizeof(text), "# %.6f lost", pose.timestamp);
-    return text;
+    written = std::snprintf(buffer, buffer_size, "# %.6f lost", pose.timestamp);
+  } else {
+    const Eigen::Vector3d t = pose.T_world_cam.translation();
+    Eigen::Quaterniond q(pose.T_world_cam.rotation());
+    // q and -q are the same rotation; pick qw >= 0 so equal poses always print the same bytes.
+    if (q.w() < 0) q.coeffs() = -q.coeffs();
+    written = std::snprintf(buffer, buffer_size, "%.6f %.9g %.9g %.9g %.9g %.9g %.9g %.9g", pose.timestamp, t.x(),
+                            t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
   }
-  const Eigen::Vector3d t = pose.T_world_cam.translation();
-  Eigen::Quaterniond q(pose.T_world_cam.rotation());
-  // q and -q are the same rotation; pick qw >= 0 so equal poses always print the same bytes.
-  if (q.w() < 0) q.coeffs() = -q.coeffs();
-  std::snprintf(text, sizeof(text), "%.6f %.9g %.9g %.9g %.9g %.9g %.9g %.9g", pose.timestamp, t.x(), t.y(),
-                t.z(), q.x(), q.y(), q.z(), q.w());
-  return text;
+  if (written < 0) written = 0;
+  return static_cast<std::size_t>(written) < buffer_size ? static_cast<std::size_t>(written) : buffer_size - 1;
+}
+
+std::string formatTumLine(const StampedPose& pose) {
+  char text[kTumLineCapacity];
+  const std::size_t length = formatTumLine(pose, text, sizeof(text));
+  return std::string(text, length);
 }
 
 Status writeTumTrajectory(const std::string& path, const std::vector<StampedPose>& poses) {
@@ -132,10 +140,12 @@ Status TumTrajectoryWriter::open(const std::string& path) {
 
 Status TumTrajectoryWriter::append(const StampedPose& pose) {
   if (!file_) return Status::Error("trajectory writer is not open");
-  const std::string line = formatTumLine(pose);
-  if (std::fprintf(file_, "%s\n", line.c_str()) < 0) return Status::Error(path_ + ": write failed");
+  char line[kTumLineCapacity];
+  formatTumLine(pose, line, sizeof(line));
+  if (std::fprintf(file_, "%s\n", line) < 0) return Status::Error(path_ + ": write failed");
   return Status::Ok();
 }
+
 
 Status TumTrajectoryWriter::close() {
   if (!file_) return Status::Ok();

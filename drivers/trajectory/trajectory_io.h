@@ -45,6 +45,11 @@ Status readTumTrajectory(const std::string& path, std::vector<StampedPose>* out,
 // Deterministic bytes (C locale number formatting, no trailing spaces), no newline.
 std::string formatTumLine(const StampedPose& pose);
 
+// The same bytes into a caller's buffer (no heap allocation, for the per-frame writer); returns
+// the length, truncating to buffer_size - 1. kTumLineCapacity always fits a whole line.
+constexpr std::size_t kTumLineCapacity = 256;
+std::size_t formatTumLine(const StampedPose& pose, char* buffer, std::size_t buffer_size);
+
 // Writes the header comment and one line per pose.
 Status writeTumTrajectory(const std::string& path, const std::vector<StampedPose>& poses);
 
@@ -57,7 +62,7 @@ class TumTrajectoryWriter {
   TumTrajectoryWriter& operator=(const TumTrajectoryWriter&) = delete;
 
   Status open(const std::string& path);
-  Status append(const StampedPose& pose);
+  Status append(const StampedPose& pose);  // allocates nothing
   Status close();
 
  private:
