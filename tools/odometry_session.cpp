@@ -7,6 +7,9 @@
 #include <cstring>
 #include <memory>
 
+#include <opencv2/core/utility.hpp>
+
+#include "drivers/dataset/tum_dataset.h"
 #include "platform/allocation_counter.h"
 
 namespace plumb::tools {
@@ -85,10 +88,23 @@ class CovarianceWriter {
   std::string path_;
 };
 
+// Frames the source will deliver when that is known in advance (a synthetic scene, a TUM-layout
+// folder), capped by max_frames; 0 when unknown (live sensors, recordings).
+std::size_t expectedFrames(FrameSource& source, long max_frames) {
+  std::size_t frames = 0;
+  if (auto* synthetic = dynamic_cast<SyntheticSource*>(&source)) frames = std::size_t(synthetic->scene().numFrames());
+  if (auto* replay = dynamic_cast<TumDatasetSource*>(&source)) frames = replay->size();
+  if (max_frames >= 0 && (frames == 0 || std::size_t(max_frames) < frames)) frames = std::size_t(max_frames);
+  return frames;
+}
+
 }  // namespace
 
 Status runSession(FrameSource& source, const SessionOptions& options, SessionResult* result) {
   result->source = source.describe();
+  // Reserved once so keeping poses for the ATE costs no allocation per frame (the steady-state
+  // allocation test runs with it on). Sources of unknown length still grow the vector.
+  if (options.keep_trajectory) result->trajectory.reserve(expectedFrames(source, options.max_frames));
   auto system = std::make_unique<OdometrySystem>(source.camera(), options.system);
   TumTrajectoryWriter trajectory_writer;
   if (!options.trajectory_path.empty()) PLUMB_RETURN_IF_ERROR(trajectory_writer.open(options.trajectory_path));
@@ -149,9 +165,18 @@ Status runSession(FrameSource& source, const SessionOptions& options, SessionRes
   };
 
   if (options.use_stages) {
+    // The stages are the parallelism: OpenCV's own worker pool (TBB) would compete with them for
+    // the cores, and each fresh pool worker allocates thread-local state (cv::theRNG) the first
+    // time a cv::parallel_for_ body runs on it, i.e. at unpredictable frames of a steady run.
+    cv::setNumThreads(0);
     StagedRunOptions staged = options.staged;
     staged.max_frames = options.max_frames;
     PLUMB_RETURN_IF_ERROR(runStaged(source, *system, staged, after_frame, &result->staged));
+    if (options.count_allocations) {
+      // The stage's window (see SessionResult): the first counted frame is the baseline.
+      result->allocation_frames = result->staged.frames_after_warmup > 0 ? result->staged.frames_after_warmup - 1 : 0;
+      result->allocations_after_warmup = result->staged.allocations_after_warmup;
+    }
   } else {
     RgbdImage image;
     while (options.max_frames < 0 || result->frames < options.max_frames) {

@@ -67,7 +67,9 @@ struct SessionResult {
   std::vector<RssCheckpoint> rss;
   std::string source;
   // count_allocations: operator new calls between the end of the warm-up frame and the end of the
-  // last frame, over that many frames (0 when the run was not longer than the warm-up).
+  // last frame, over that many frames (0 when the run was not longer than the warm-up). Staged
+  // runs end the window at the last frame finished before the input ended, because the stage
+  // threads' exit allocates (OpenCV's thread-local cleanup): shutdown, not per-frame cost.
   uint64_t allocation_frames = 0;
   uint64_t allocations_after_warmup = 0;
   StagedRunResult staged;  // use_stages: latency report, extraction failures

@@ -1,5 +1,6 @@
 #include "tools/staged_run.h"
 
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -15,6 +16,11 @@ namespace plumb::tools {
 
 namespace {
 
+// Set by the capture stage when its source has no more frames. From then on the stage threads
+// wind down, and a thread's exit allocates inside OpenCV's thread-local-storage cleanup: teardown,
+// not per-frame cost, so the steady-state allocation window closes here (see OdometryStage).
+using InputEnded = std::atomic<bool>;
+
 // What one slot carries through the stages. FrameFeatures is large (fixed capacities), so it lives
 // on the heap, allocated once with the slot.
 struct OdometrySlot {
@@ -29,17 +35,18 @@ struct OdometrySlot {
 // finished frame.
 class CaptureStage final : public runtime::Source<OdometrySlot> {
  public:
-  CaptureStage(FrameSource& source, long max_frames) : source_(source), max_frames_(max_frames) {}
+  CaptureStage(FrameSource& source, long max_frames, InputEnded& input_ended)
+      : source_(source), max_frames_(max_frames), input_ended_(input_ended) {}
 
   bool peekNext(int64_t* t_recorded_ns) override {
     if (staged_) {
       *t_recorded_ns = staged_t_ns_;
       return true;
     }
-    if (max_frames_ >= 0 && consumed_ >= max_frames_) return false;
+    if (max_frames_ >= 0 && consumed_ >= max_frames_) return ended();
     for (;;) {
       const SourceResult r = source_.next(staging_);
-      if (r == SourceResult::kEndOfStream) return false;
+      if (r == SourceResult::kEndOfStream) return ended();
       if (r == SourceResult::kNoFrame) continue;  // live source timeout: ask again
       staged_ = true;
       if (r == SourceResult::kError) {
@@ -70,8 +77,14 @@ class CaptureStage final : public runtime::Source<OdometrySlot> {
   }
 
  private:
+  bool ended() {
+    input_ended_.store(true);
+    return false;
+  }
+
   FrameSource& source_;
   long max_frames_;
+  InputEnded& input_ended_;
   long consumed_ = 0;
   RgbdImage staging_;
   bool staged_ = false;
@@ -86,11 +99,16 @@ class CaptureStage final : public runtime::Source<OdometrySlot> {
 // frame rate; this one only decodes what it delivers.
 class TumReplayCapture final : public runtime::Source<OdometrySlot> {
  public:
-  TumReplayCapture(TumDatasetSource& replay, long max_frames) : replay_(replay), max_frames_(max_frames) {}
+  TumReplayCapture(TumDatasetSource& replay, long max_frames, InputEnded& input_ended)
+      : replay_(replay), max_frames_(max_frames), input_ended_(input_ended) {}
 
   bool peekNext(int64_t* t_recorded_ns) override {
-    if (next_ >= replay_.size()) return false;
-    if (max_frames_ >= 0 && next_ >= static_cast<std::size_t>(max_frames_)) return false;
+    const bool at_end =
+        next_ >= replay_.size() || (max_frames_ >= 0 && next_ >= static_cast<std::size_t>(max_frames_));
+    if (at_end) {
+      input_ended_.store(true);
+      return false;
+    }
     *t_recorded_ns = std::llround(replay_.timestamp(next_) * 1e9);
     return true;
   }
@@ -104,6 +122,7 @@ class TumReplayCapture final : public runtime::Source<OdometrySlot> {
  private:
   TumDatasetSource& replay_;
   long max_frames_;
+  InputEnded& input_ended_;
   std::size_t next_ = 0;  // the replay's own cursor is not used: load() is random access
 };
 
@@ -131,20 +150,25 @@ class ExtractStage final : public runtime::Stage<OdometrySlot> {
 // Stage 2: tracking, keyframe decision and local mapping, in frame order.
 class OdometryStage final : public runtime::Stage<OdometrySlot> {
  public:
-  OdometryStage(OdometrySystem& system, const FrameOutputFn& on_output, uint64_t warmup_frames)
-      : system_(system), on_output_(on_output), warmup_frames_(warmup_frames) {}
+  OdometryStage(OdometrySystem& system, const FrameOutputFn& on_output, uint64_t warmup_frames,
+                const InputEnded& input_ended)
+      : system_(system), on_output_(on_output), warmup_frames_(warmup_frames), input_ended_(input_ended) {}
   const char* name() const override { return "odometry"; }
   Status process(OdometrySlot& slot, const runtime::FrameStamps& stamps) override {
     const FrameOutput& out =
         system_.processFeatures(*slot.features, slot.image.sequence, slot.image.timestamp_s);
     Status status = on_output_ ? on_output_(out) : Status::Ok();
     // Process-wide count, read on this thread after each frame: from the first frame at or after
-    // warm-up to the last one, every thread's allocations are included.
+    // warm-up to the last one finished before the input ended, every thread's allocations are
+    // included. The count is read before the flag, so a reading taken after a stage thread began
+    // to exit is never kept.
     if (stamps.frame_index >= warmup_frames_) {
       const uint64_t now = allocationCount();
-      if (frames_after_warmup_ == 0) allocations_at_warmup_ = now;
-      allocations_at_last_ = now;
-      ++frames_after_warmup_;
+      if (!input_ended_.load()) {
+        if (frames_after_warmup_ == 0) allocations_at_warmup_ = now;
+        allocations_at_last_ = now;
+        ++frames_after_warmup_;
+      }
     }
     return status;
   }
@@ -155,6 +179,7 @@ class OdometryStage final : public runtime::Stage<OdometrySlot> {
   OdometrySystem& system_;
   const FrameOutputFn& on_output_;
   uint64_t warmup_frames_;
+  const InputEnded& input_ended_;
   uint64_t frames_after_warmup_ = 0;
   uint64_t allocations_at_warmup_ = 0;
   uint64_t allocations_at_last_ = 0;
@@ -165,14 +190,17 @@ class OdometryStage final : public runtime::Stage<OdometrySlot> {
 Status runStaged(FrameSource& source, OdometrySystem& system, const StagedRunOptions& options,
                  const FrameOutputFn& on_output, StagedRunResult* result) {
   // A TUM replay is read by index (cheap peek/skip); any other source through next() + read-ahead.
-  CaptureStage generic_capture(source, options.max_frames);
+  InputEnded input_ended{false};
+  CaptureStage generic_capture(source, options.max_frames, input_ended);
   auto* replay = dynamic_cast<TumDatasetSource*>(&source);
   std::unique_ptr<TumReplayCapture> replay_capture;
-  if (replay != nullptr) replay_capture = std::make_unique<TumReplayCapture>(*replay, options.max_frames);
+  if (replay != nullptr) {
+    replay_capture = std::make_unique<TumReplayCapture>(*replay, options.max_frames, input_ended);
+  }
   runtime::Source<OdometrySlot>& capture =
       replay_capture ? static_cast<runtime::Source<OdometrySlot>&>(*replay_capture) : generic_capture;
   ExtractStage extract(system.extractor());
-  OdometryStage odometry(system, on_output, options.warmup_frames);
+  OdometryStage odometry(system, on_output, options.warmup_frames, input_ended);
   runtime::RunOptions run_options;
   run_options.mode = options.mode;
   run_options.slot_count = options.slot_count;

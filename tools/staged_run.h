@@ -41,8 +41,11 @@ struct StagedRunOptions {
 struct StagedRunResult {
   runtime::RunReport report;
   uint64_t extraction_failures = 0;  // frames whose image did not match the camera (tracked featureless)
-  uint64_t frames_after_warmup = 0;  // frames the odometry stage finished from warmup_frames on
-  uint64_t allocations_after_warmup = 0;  // process-wide operator new calls meanwhile
+  // Frames the odometry stage finished from warmup_frames on, until the capture stage found the
+  // input ended (then the stage threads start to exit, and a thread's exit allocates inside
+  // OpenCV's thread-local cleanup: shutdown, not per-frame cost).
+  uint64_t frames_after_warmup = 0;
+  uint64_t allocations_after_warmup = 0;  // process-wide operator new calls between the first and last of them
 };
 
 using FrameOutputFn = std::function<Status(const FrameOutput&)>;
