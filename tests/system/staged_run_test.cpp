@@ -2,7 +2,6 @@
 // extract -> odometry, tools/staged_run.h) against the single-threaded loop, through the built tool.
 // Lock-step (deterministic) must write the very same trajectory bytes; the threaded fast mode must
 // account for every frame, in order. A short synthetic sequence keeps the test to a few seconds.
-#include <sys/wait.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -16,49 +15,23 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/support/plumb_cli.h"
+
 namespace {
+
+using plumb::test::runPlumb;
+using plumb::test::RunResult;
+
+class ScratchDir : public plumb::test::ScratchDir {
+ public:
+  ScratchDir() : plumb::test::ScratchDir("plumb_staged") {}
+};
 
 namespace fs = std::filesystem;
 
-const std::string kPlumb = PLUMB_BINARY_DIR "/bin/plumb";
+const std::string kPlumb = plumb::test::kPlumbBinary;
 constexpr int kFrames = 60;
 const std::string kDataset = "synth:low_texture:1:" + std::to_string(kFrames);
-
-struct RunResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr together
-};
-
-RunResult runPlumb(const std::string& arguments) {
-  RunResult result;
-  const std::string command = "'" + kPlumb + "' " + arguments + " 2>&1";
-  std::FILE* pipe = ::popen(command.c_str(), "r");
-  if (!pipe) return result;
-  char buffer[4096];
-  std::size_t n;
-  while ((n = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0) result.output.append(buffer, n);
-  const int status = ::pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
-
-// A private folder per test (ctest runs tests as parallel processes).
-class ScratchDir {
- public:
-  ScratchDir() {
-    std::string pattern = (fs::temp_directory_path() / "plumb_staged_XXXXXX").string();
-    if (::mkdtemp(pattern.data())) path_ = pattern;
-  }
-  ~ScratchDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  bool ok() const { return !path_.empty(); }
-  std::string file(const std::string& name) const { return path_ + "/" + name; }
-
- private:
-  std::string path_;
-};
 
 std::string readBytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

@@ -1,8 +1,5 @@
 // `plumb eval` from the command line: the published answers, JSON output, the plot, and bad input
 // (non-zero exit and a message naming the file).
-#include <gtest/gtest.h>
-#include <sys/wait.h>
-
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -10,49 +7,21 @@
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 
+#include <gtest/gtest.h>
+
+#include "tests/support/plumb_cli.h"
+
 namespace {
 
-const std::string kPlumb = PLUMB_BINARY_DIR "/bin/plumb";
-const std::string kReference = PLUMB_DATASETS_DIR "/reference_trajectories";
+using plumb::test::runPlumb;
+using plumb::test::RunResult;
 
-struct RunResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr together
-};
-
-RunResult runPlumb(const std::string& arguments) {
-  RunResult result;
-  const std::string command = "'" + kPlumb + "' " + arguments + " 2>&1";
-  std::FILE* pipe = ::popen(command.c_str(), "r");
-  if (!pipe) return result;
-  char buffer[4096];
-  std::size_t n;
-  while ((n = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0) result.output.append(buffer, n);
-  const int status = ::pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
-
-// A private folder per test (ctest runs tests as parallel processes).
-class ScratchDir {
+class ScratchDir : public plumb::test::ScratchDir {
  public:
-  ScratchDir() {
-    std::string pattern = (std::filesystem::temp_directory_path() / "plumb_eval_XXXXXX").string();
-    if (::mkdtemp(pattern.data())) path_ = pattern;
-  }
-  ~ScratchDir() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
-  std::string write(const std::string& name, const std::string& content) const {
-    std::ofstream(path_ + "/" + name, std::ios::binary) << content;
-    return path_ + "/" + name;
-  }
-  std::string file(const std::string& name) const { return path_ + "/" + name; }
-
- private:
-  std::string path_;
+  ScratchDir() : plumb::test::ScratchDir("plumb_eval") {}
 };
+
+const std::string kReference = PLUMB_DATASETS_DIR "/reference_trajectories";
 
 bool haveReferenceTrajectories() { return std::filesystem::is_directory(kReference); }
 

@@ -1,7 +1,6 @@
 // `plumb synth` from the command line: the same options give a byte-identical folder, another seed
 // gives other bytes, and bad options exit non-zero with a message that says what is wrong.
 // Short runs keep the test fast; the 300-frame acceptance run is the same code path.
-#include <sys/wait.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -13,47 +12,21 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/support/plumb_cli.h"
+
 namespace {
+
+using plumb::test::runPlumb;
+using plumb::test::RunResult;
+
+class ScratchDir : public plumb::test::ScratchDir {
+ public:
+  ScratchDir() : plumb::test::ScratchDir("plumb_synth") {}
+};
 
 namespace fs = std::filesystem;
 
-const std::string kPlumb = PLUMB_BINARY_DIR "/bin/plumb";
 constexpr int kFrames = 20;  // keeps each run short; determinism does not depend on the count
-
-struct RunResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr together
-};
-
-RunResult runPlumb(const std::string& arguments) {
-  RunResult result;
-  const std::string command = "'" + kPlumb + "' " + arguments + " 2>&1";
-  std::FILE* pipe = ::popen(command.c_str(), "r");
-  if (!pipe) return result;
-  char buffer[4096];
-  std::size_t n;
-  while ((n = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0) result.output.append(buffer, n);
-  const int status = ::pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
-
-// A private folder per test (ctest runs tests as parallel processes).
-class ScratchDir {
- public:
-  ScratchDir() {
-    std::string pattern = (fs::temp_directory_path() / "plumb_synth_XXXXXX").string();
-    if (::mkdtemp(pattern.data())) path_ = pattern;
-  }
-  ~ScratchDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  std::string file(const std::string& name) const { return path_ + "/" + name; }
-
- private:
-  std::string path_;
-};
 
 // Every regular file under `root`, keyed by its path relative to `root`, with its bytes.
 std::map<std::string, std::string> readTree(const std::string& root) {
