@@ -51,10 +51,13 @@ void printUsage() {
   std::printf(
       "usage: plumb bench frontend --dataset DIR [--camera tum1] [--frames N] [--no-stock]\n"
       "                            [--line-level L] [--line-samples N] [--opencv-lsd] [--clock wall|cpu]\n"
+      "                            [--dump FILE]\n"
       "  Runs the front end (pipeline/feature_extractor.h) with default ExtractorOptions on every\n"
       "  frame of a TUM-layout folder, single thread, then the stock OpenCV path on the same frame.\n"
       "  --clock: what the two summary lines report: wall (steady clock, default) or cpu (this\n"
-      "  thread's CPU time, which does not count waiting for a core on a loaded machine).\n");
+      "  thread's CPU time, which does not count waiting for a core on a loaded machine).\n"
+      "  --dump: write every extracted feature (keypoints, descriptors, lines, samples) as text, so\n"
+      "  a speed change can be checked to leave the output bit-identical (diff two dumps).\n");
 }
 
 // The stock path the issue compares against: cv::ORB 1000 features, 8 levels, 1.2, and the contrib
@@ -83,8 +86,32 @@ struct StockPath {
   }
 };
 
+// One line per feature, floats as hex so "identical" means bit-identical.
+void dumpFeatures(std::FILE* f, size_t frame, const FrameFeatures& features) {
+  std::fprintf(f, "frame %zu keypoints %zu lines %zu\n", frame, features.keypoints.size(), features.lines.size());
+  for (size_t i = 0; i < features.keypoints.size(); ++i) {
+    const KeypointObservation& k = features.keypoints[i];
+    const Descriptor256& d = features.keypoint_descriptors[i];
+    std::fprintf(f, "k %a %a %a %a %a %a %d %a %016llx%016llx%016llx%016llx\n", k.px.x(), k.px.y(), k.px_undist.x(),
+                 k.px_undist.y(), k.angle_deg, k.response, k.octave, k.depth_m, (unsigned long long)d.words[0],
+                 (unsigned long long)d.words[1], (unsigned long long)d.words[2], (unsigned long long)d.words[3]);
+  }
+  for (size_t i = 0; i < features.lines.size(); ++i) {
+    const LineObservation& l = features.lines[i];
+    const Descriptor256& d = features.line_descriptors[i];
+    std::fprintf(f, "l %a %a %a %a %a %a %a %d %a %d %d %016llx%016llx%016llx%016llx", l.start_px.x(), l.start_px.y(),
+                 l.end_px.x(), l.end_px.y(), l.l.x(), l.l.y(), l.l.z(), l.octave, l.response, l.num_samples, l.has_3d,
+                 (unsigned long long)d.words[0], (unsigned long long)d.words[1], (unsigned long long)d.words[2],
+                 (unsigned long long)d.words[3]);
+    for (int s = 0; s < l.num_samples; ++s) {
+      std::fprintf(f, " %a %a %a", l.sample_P_cam[s].x(), l.sample_P_cam[s].y(), l.sample_P_cam[s].z());
+    }
+    std::fprintf(f, "\n");
+  }
+}
+
 int benchFrontend(int argc, char** argv) {
-  Args args(argc, argv, {"dataset", "camera", "frames", "line-level", "line-samples", "clock"}, {"no-stock", "opencv-lsd"});
+  Args args(argc, argv, {"dataset", "camera", "frames", "line-level", "line-samples", "clock", "dump"}, {"no-stock", "opencv-lsd"});
   if (args.help()) { printUsage(); return 0; }
   if (!args.error().empty() || !args.has("dataset")) {
     std::fprintf(stderr, "plumb bench frontend: %s\n", args.error().empty() ? "--dataset is required" : args.error().c_str());
@@ -119,6 +146,11 @@ int benchFrontend(int argc, char** argv) {
   FeatureExtractor extractor(camera, options);
   auto features = std::make_unique<FrameFeatures>();
   StockPath stock;
+  std::FILE* dump = nullptr;
+  if (args.has("dump")) {
+    dump = std::fopen(args.get("dump").c_str(), "w");
+    if (dump == nullptr) { std::fprintf(stderr, "plumb bench frontend: cannot write %s\n", args.get("dump").c_str()); return 1; }
+  }
   const bool run_stock = !args.has("no-stock");
 
   Series orb{"ORB", {}}, lines{"lines + LBD", {}}, depth{"depth + sampling", {}}, total{"frontend total", {}};
@@ -136,6 +168,7 @@ int benchFrontend(int argc, char** argv) {
       std::fprintf(stderr, "plumb bench frontend: frame %zu does not match the camera size\n", i);
       return 1;
     }
+    if (dump != nullptr) dumpFeatures(dump, i, *features);
     const ExtractorTimings& t = extractor.lastTimings();
     orb.ms.push_back(t.orb_ms);
     lines.ms.push_back(t.lines_ms);
@@ -161,6 +194,7 @@ int benchFrontend(int argc, char** argv) {
       sum_stock_lines += stock.keylines.size();
     }
   }
+  if (dump != nullptr) std::fclose(dump);
   const double frames = std::max<size_t>(n, 1);
   std::printf("plumb bench frontend: %zu frames of %s, 1 thread\n", n, args.get("dataset").c_str());
   std::printf("  per frame: %.0f keypoints (%.0f with depth), %.0f lines (%.0f with a 3D fit, %d samples max)\n",
