@@ -19,7 +19,7 @@ ImagePyramid::ImagePyramid(int width, int height, int num_levels, float scale_fa
     total_rows += sizes[i].height;
   }
   row_filtered_.create(1, width + 6, CV_16UC1);  // one padded row
-  row_pair_.create(2, width, CV_32SC1);
+  vertical_row_.create(1, width, CV_32SC1);
   for (int i = 1; i < num_levels_; ++i) {
     x_tap_start_[i] = static_cast<int>(x_taps_.size());
     appendTaps(sizes[i - 1].width, sizes[i].width, x_taps_);
@@ -73,39 +73,36 @@ void ImagePyramid::downsample(int level) {
   const Tap* x_taps = x_taps_.data() + x_tap_start_[level];
   const Tap* y_taps = y_taps_.data() + y_tap_start_[level];
   const int one = 1 << kWeightBits;
-  // Horizontal pass into 32-bit rows (value * 2048), cached: with a 1.2 step most source rows
-  // feed two destination rows, so the pair is reused or shifted instead of recomputed.
-  int* rows[2] = {row_pair_.ptr<int>(0), row_pair_.ptr<int>(1)};
-  int cached[2] = {-1, -1};
-  auto sampleRow = [&](int src_row, int* out) {
-    const uint8_t* p = src.ptr<uint8_t>(src_row);
-    for (int x = 0; x < dst.cols; ++x) {
-      const Tap& t = x_taps[x];
-      out[x] = p[t.index0] * (one - t.weight) + p[t.index1] * t.weight;
-    }
-  };
+  constexpr int kRound = 1 << (2 * kWeightBits - 1);
+  // Each output pixel is the exact integer sum_ij p_ij * wy_i * wx_j (<= 255 * 2048^2, fits an
+  // int32), rounded once at the end, so the order of the two passes does not change a single
+  // value. Vertical first: it runs along contiguous source rows, 8 pixels per multiply-add of
+  // interleaved (row0, row1) 16-bit pairs against (wy0, wy1); the horizontal pass then gathers from
+  // one int32 row per output row.
+  int* vertical = vertical_row_.ptr<int>(0);
   for (int y = 0; y < dst.rows; ++y) {
     const Tap& ty = y_taps[y];
-    if (cached[0] != ty.index0) {
-      if (cached[1] == ty.index0) {
-        std::swap(rows[0], rows[1]);
-        std::swap(cached[0], cached[1]);
-      } else {
-        sampleRow(ty.index0, rows[0]);
-        cached[0] = ty.index0;
-      }
-    }
-    if (cached[1] != ty.index1) {
-      sampleRow(ty.index1, rows[1]);
-      cached[1] = ty.index1;
-    }
-    // Vertical pass: 255 * 2048 * 2048 + rounding still fits a signed 32-bit int.
-    uint8_t* d = dst.ptr<uint8_t>(y);
+    const uint8_t* s0 = src.ptr<uint8_t>(ty.index0);
+    const uint8_t* s1 = src.ptr<uint8_t>(ty.index1);
     const int w1 = ty.weight, w0 = one - w1;
-    const int* r0 = rows[0];
-    const int* r1 = rows[1];
-    for (int x = 0; x < dst.cols; ++x) {
-      d[x] = static_cast<uint8_t>((r0[x] * w0 + r1[x] * w1 + (1 << (2 * kWeightBits - 1))) >> (2 * kWeightBits));
+    const cv::v_int16x8 weights = cv::v_reinterpret_as_s16(cv::v_setall_s32(w0 | (w1 << 16)));
+    int x = 0;
+    for (; x + 8 <= src.cols; x += 8) {
+      const cv::v_int16x8 a = cv::v_reinterpret_as_s16(cv::v_load_expand(s0 + x));
+      const cv::v_int16x8 b = cv::v_reinterpret_as_s16(cv::v_load_expand(s1 + x));
+      cv::v_int16x8 lo, hi;
+      cv::v_zip(a, b, lo, hi);  // (a0, b0, a1, b1, ...)
+      cv::v_store(vertical + x, cv::v_dotprod(lo, weights));
+      cv::v_store(vertical + x + 4, cv::v_dotprod(hi, weights));
+    }
+    for (; x < src.cols; ++x) vertical[x] = s0[x] * w0 + s1[x] * w1;
+    // Horizontal: v0 * (2048 - w) + v1 * w written as v0 * 2048 + (v1 - v0) * w, one multiply;
+    // every term stays within +-255 * 2048^2.
+    uint8_t* d = dst.ptr<uint8_t>(y);
+    for (int xd = 0; xd < dst.cols; ++xd) {
+      const Tap& t = x_taps[xd];
+      const int v0 = vertical[t.index0], v1 = vertical[t.index1];
+      d[xd] = static_cast<uint8_t>((v0 * one + (v1 - v0) * t.weight + kRound) >> (2 * kWeightBits));
     }
   }
 }

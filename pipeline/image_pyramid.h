@@ -48,7 +48,7 @@ class ImagePyramid {
   static void appendTaps(int src_size, int dst_size, std::vector<Tap>& taps);
   std::vector<Tap> x_taps_, y_taps_;                          // all levels, concatenated
   std::array<int, kPyramidLevels> x_tap_start_{}, y_tap_start_{};  // each level's first entry
-  cv::Mat row_pair_;                // CV_32SC1, 2 rows: the two horizontally sampled source rows
+  cv::Mat vertical_row_;            // CV_32SC1, one source row: the downsampler's vertical pass
 
   cv::Mat buffer_, blurred_buffer_;
   cv::Mat row_filtered_;            // CV_16UC1, one row + 3 px padding each side: the blur's vertical pass

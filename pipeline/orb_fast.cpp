@@ -101,26 +101,42 @@ void FastDetector::scan(int threshold, int x0, int y0, int x1, int y1) {
       }
       maybe = (bright >= four) | (dark >= four);
       if (!cv::v_check_any(maybe)) return;
-      // Score of all 16 lanes at once, in saturating u8 arithmetic: with b_k = sat(I_k - c) and
-      // e_k = sat(c - I_k), the score is the max over the 16 arcs of 9 of min(b) or min(e);
-      // a pixel is a corner exactly when its score exceeds the threshold (the segment test).
-      cv::v_uint8x16 b[32], e[32];
-      for (int k = 0; k < 16; ++k) {
-        const cv::v_uint8x16 q = cv::v_load(row + bx + circle[k]);
-        b[k] = b[k + 16] = q - c;
-        e[k] = e[k + 16] = c - q;
+      // Third filter, the full count: an arc of 9 needs >= 9 of all 16 pixels on one side. It
+      // also tells which sides can still have a corner, so only those get scored below.
+      cv::v_uint8x16 q[16];
+      for (int k = 0; k < 16; ++k) q[k] = cv::v_load(row + bx + circle[k]);
+      for (int k = 1; k < 16; k += 2) {
+        bright += (q[k] > hi) & one;
+        dark += (q[k] < lo) & one;
       }
+      const cv::v_uint8x16 nine = cv::v_setall_u8(9);
+      const cv::v_uint8x16 maybe_bright = (bright >= nine) & maybe, maybe_dark = (dark >= nine) & maybe;
+      const bool any_bright = cv::v_check_any(maybe_bright), any_dark = cv::v_check_any(maybe_dark);
+      if (!any_bright && !any_dark) return;
+      maybe = maybe_bright | maybe_dark;
+      // Score in saturating u8 arithmetic: with b_k = sat(I_k - c) and e_k = sat(c - I_k), the
+      // score is the max over the 16 arcs of 9 of min(b) (bright side) or min(e) (dark side); a
+      // pixel is a corner exactly when its score exceeds the threshold (the segment test). Arcs
+      // of 9 of 16 cannot be bright and dark at once, so a corner's score is that of the side
+      // that passed the count: a side no lane can pass is skipped without changing any score.
+      auto sideScore = [](const cv::v_uint8x16* diff, cv::v_uint8x16 score) {
+        cv::v_uint8x16 d2[31];
+        for (int k = 0; k < 31; ++k) d2[k] = cv::v_min(diff[k & 15], diff[(k + 1) & 15]);
+        for (int k = 0; k < 16; ++k) {
+          const cv::v_uint8x16 d4a = cv::v_min(d2[k], d2[k + 2]), d4b = cv::v_min(d2[k + 4], d2[k + 6]);
+          score = cv::v_max(score, cv::v_min(cv::v_min(d4a, d4b), diff[(k + 8) & 15]));
+        }
+        return score;
+      };
       cv::v_uint8x16 score = cv::v_setzero_u8();
-      cv::v_uint8x16 b2[31], e2[31];
-      for (int k = 0; k < 31; ++k) {
-        b2[k] = cv::v_min(b[k], b[k + 1]);
-        e2[k] = cv::v_min(e[k], e[k + 1]);
+      cv::v_uint8x16 diff[16];
+      if (any_bright) {
+        for (int k = 0; k < 16; ++k) diff[k] = q[k] - c;
+        score = sideScore(diff, score);
       }
-      for (int k = 0; k < 16; ++k) {
-        const cv::v_uint8x16 b4a = cv::v_min(b2[k], b2[k + 2]), b4b = cv::v_min(b2[k + 4], b2[k + 6]);
-        const cv::v_uint8x16 e4a = cv::v_min(e2[k], e2[k + 2]), e4b = cv::v_min(e2[k + 4], e2[k + 6]);
-        score = cv::v_max(score, cv::v_min(cv::v_min(b4a, b4b), b[k + 8]));
-        score = cv::v_max(score, cv::v_min(cv::v_min(e4a, e4b), e[k + 8]));
+      if (any_dark) {
+        for (int k = 0; k < 16; ++k) diff[k] = c - q[k];
+        score = sideScore(diff, score);
       }
       int mask = cv::v_signmask((score > t) & maybe) & (0xFFFF << first_lane);
       if (!mask) return;
