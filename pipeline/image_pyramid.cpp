@@ -30,6 +30,8 @@ ImagePyramid::ImagePyramid(int width, int height, int num_levels, float scale_fa
   int sum = 0;
   for (int k = 0; k < 7; ++k) sum += kernel_[k] = static_cast<int>(std::lround(kernel.at<double>(k) * 256));
   kernel_[3] += 256 - sum;  // exact unit gain
+  // blur() relies on the symmetry (rounding symmetric weights keeps them symmetric).
+  CV_Assert(kernel_[0] == kernel_[6] && kernel_[1] == kernel_[5] && kernel_[2] == kernel_[4]);
   buffer_.create(total_rows, width, CV_8UC1);
   blurred_buffer_.create(total_rows, width, CV_8UC1);
   buffer_.setTo(0);
@@ -123,13 +125,19 @@ void ImagePyramid::blur(const cv::Mat& src, cv::Mat& dst) {
     const uint8_t* r[7];
     for (int i = 0; i < 7; ++i) r[i] = src.ptr<uint8_t>(reflect(y + i - 3, h));
     int x = 0;
+    // The kernel is symmetric: rows 3 - i and 3 + i are added first (<= 510) and multiplied
+    // once, 4 multiplies instead of 7 for the same integer sum (<= 65280: no overflow).
     for (; x + 16 <= w; x += 16) {
-      cv::v_uint16x8 lo = cv::v_setzero_u16(), hi = cv::v_setzero_u16();
-      for (int i = 0; i < 7; ++i) {
-        cv::v_uint16x8 a, b;
+      cv::v_uint16x8 lo, hi, a, b;
+      cv::v_expand(cv::v_load(r[3] + x), lo, hi);
+      lo = cv::v_mul_wrap(lo, vk[3]);
+      hi = cv::v_mul_wrap(hi, vk[3]);
+      for (int i = 0; i < 3; ++i) {
+        cv::v_uint16x8 c, e;
         cv::v_expand(cv::v_load(r[i] + x), a, b);
-        lo += cv::v_mul_wrap(a, vk[i]);  // the sum stays <= 65280: no overflow
-        hi += cv::v_mul_wrap(b, vk[i]);
+        cv::v_expand(cv::v_load(r[6 - i] + x), c, e);
+        lo += cv::v_mul_wrap(a + c, vk[i]);
+        hi += cv::v_mul_wrap(b + e, vk[i]);
       }
       cv::v_store(t + x, (lo + half) >> 8);
       cv::v_store(t + x + 8, (hi + half) >> 8);
@@ -146,8 +154,8 @@ void ImagePyramid::blur(const cv::Mat& src, cv::Mat& dst) {
     uint8_t* d = dst.ptr<uint8_t>(y);
     x = 0;
     for (; x + 8 <= w; x += 8) {
-      cv::v_uint16x8 acc = cv::v_setzero_u16();
-      for (int i = 0; i < 7; ++i) acc += cv::v_mul_wrap(cv::v_load(t + x + i - 3), vk[i]);
+      cv::v_uint16x8 acc = cv::v_mul_wrap(cv::v_load(t + x), vk[3]);
+      for (int i = 0; i < 3; ++i) acc += cv::v_mul_wrap(cv::v_load(t + x + i - 3) + cv::v_load(t + x + 3 - i), vk[i]);
       cv::v_pack_store(d + x, (acc + half) >> 8);
     }
     for (; x < w; ++x) {

@@ -56,6 +56,7 @@ class LineSegmentDetector {
   std::vector<uint8_t> state_;                    // 0 free, 1 used or below threshold
   std::vector<int> bucket_start_, ordered_;       // bucket sort of candidate pixels
   std::vector<int> region_;                       // pixel indices of the growing region
+  std::vector<int16_t> region_x_, region_y_;      // ... and their coordinates (no divisions)
 };
 
 }  // namespace plumb
