@@ -8,9 +8,23 @@
 //   map segment starts from the current frame at the last known pose (the trajectory continues).
 //
 // processImage() runs every step for one frame; processFeatures() starts after extraction (for a
-// runtime that extracts on another thread). The components are reachable for such a runtime.
+// runtime that extracts on another thread). processFeatures() is trackFeatures() then mapFrame(),
+// and a staged runtime calls those two on separate threads (tracking and mapping stages):
+//
+//   trackFeatures (tracking thread): installs the newest LocalMap snapshot the mapping side
+//     published (runtime::LatestSnapshot, newer versions only), tracks, and fills a TrackedFrame
+//     (pose, reference keyframe, keyframe request) that travels with the frame to
+//   mapFrame (mapping thread, frame order): LocalMapper::insertKeyframe + local BA for a request,
+//     publishes the new snapshot, updates the relocalizer, statistics and the output trajectory.
+//
+// Rare events need the mapper and relocalizer synchronously: starting a map (segment) and
+// relocalizing. Before them trackFeatures() calls MapperFence::waitForMapper(), which returns once
+// every earlier frame has been through mapFrame() (the mapping thread is then idle until this frame
+// reaches it), so the two threads never touch the mapper or relocalizer at the same time. In
+// lock-step (and in processFeatures) the fence never waits and every frame sees exactly the
+// single-threaded map; threaded runs track against the newest snapshot published so far.
 // Output: finished frames (reference-keyframe relative, see OdometryTrajectory) and retired
-// keyframes with their covariance, drained by the caller.
+// keyframes with their covariance, drained by the caller on the mapping side.
 #include <cstdint>
 #include <memory>
 
@@ -24,6 +38,7 @@
 #include "pipeline/relocalizer.h"
 #include "pipeline/rgbd_image.h"
 #include "pipeline/tracker.h"
+#include "runtime/latest_snapshot.h"
 
 namespace plumb {
 
@@ -36,9 +51,29 @@ struct FrameOutput {
   bool keyframe = false;
   bool relocalized = false;
   bool new_map = false;
+  bool dropped = false;  // mapDroppedFrame(): the runtime dropped this frame, nothing else is set
   TrackResult track;
   InsertResult insert;
   double extract_ms = 0, track_ms = 0, map_ms = 0;
+};
+
+// What tracking hands to mapping for one frame. Large (the request holds a copy of the features),
+// so a staged runtime allocates one per frame slot, once.
+struct TrackedFrame {
+  FrameOutput output;            // tracking's part: state, pose, flags, track result, track_ms
+  uint32_t reference_id = 0;     // keyframe the output trajectory expresses the pose against
+  Eigen::Isometry3d T_ref_cam = Eigen::Isometry3d::Identity();
+  bool map_keyframe = false;     // `request` is to be inserted by mapFrame()
+  bool relocalization_attempted = false;
+  KeyframeRequest request;
+};
+
+// How the tracking side waits for the mapping side in a threaded run (see the header comment).
+class MapperFence {
+ public:
+  virtual ~MapperFence() = default;
+  // Returns once every frame tracked before the current one has been through mapFrame().
+  virtual void waitForMapper() = 0;
 };
 
 struct SystemOptions {
@@ -57,6 +92,15 @@ class OdometrySystem {
   const FrameOutput& processImage(const RgbdImage& image);
   const FrameOutput& processFeatures(const FrameFeatures& features, uint64_t sequence, double timestamp_s);
 
+  // The two halves of processFeatures() (header comment). fence may be nullptr (never waits).
+  void trackFeatures(const FrameFeatures& features, uint64_t sequence, double timestamp_s, MapperFence* fence,
+                     TrackedFrame* out);
+  const FrameOutput& mapFrame(const TrackedFrame& tracked);
+  // Mapping side: a frame the runtime dropped (real-time replay, no free slot) takes its place in
+  // the output trajectory (FinishedFrame::dropped); call in frame order between mapFrame() calls.
+  const FrameOutput& mapDroppedFrame(uint64_t sequence, double timestamp_s);
+
+  // Mapping side (mapFrame's thread) from here on.
   // Frames whose output pose is final, oldest first; fn(const FinishedFrame&).
   template <typename Fn>
   void drainFinishedFrames(Fn fn) { trajectory_.popReady(mapper_->localMap(), fn); }
@@ -83,12 +127,15 @@ class OdometrySystem {
   Relocalizer& relocalizer() { return *relocalizer_; }
 
  private:
+  // Tracking side.
+  void installNewestSnapshot();
   bool canStartMap(const FrameFeatures& features) const;
   void startMap(const FrameFeatures& features, uint64_t sequence, double timestamp_s,
-                const Eigen::Isometry3d& T_world_cam);
-  void insertKeyframe();
-  void tryRelocalize(const FrameFeatures& features);
-  void recordOutput();
+                const Eigen::Isometry3d& T_world_cam, MapperFence* fence, TrackedFrame* out);
+  void tryRelocalize(const FrameFeatures& features, MapperFence* fence, TrackedFrame* out);
+  // Mapping side.
+  void insertKeyframe(const KeyframeRequest& request);
+  void recordOutput(const TrackedFrame& tracked);
 
   PinholeCamera camera_;
   SystemOptions options_;
@@ -97,14 +144,18 @@ class OdometrySystem {
   std::unique_ptr<LocalMapper> mapper_;
   std::unique_ptr<Relocalizer> relocalizer_;
   std::unique_ptr<FrameFeatures> features_;
-  std::unique_ptr<KeyframeRequest> request_;
-  OdometryTrajectory trajectory_;
-  OdometryStats stats_;
-  FrameOutput output_;
+  std::unique_ptr<TrackedFrame> tracked_;  // processFeatures()'s hand-over
+  // Mapping -> tracking: LocalMap snapshots after each inserted keyframe (triple buffer).
+  std::unique_ptr<runtime::LatestSnapshot<LocalMap>> snapshots_;
+  // Tracking side state.
   bool map_started_ = false;
   bool lost_ = false;
   int lost_streak_ = 0;
   Eigen::Isometry3d T_world_last_good_ = Eigen::Isometry3d::Identity();
+  // Mapping side state.
+  OdometryTrajectory trajectory_;
+  OdometryStats stats_;
+  FrameOutput output_;
 };
 
 }  // namespace plumb

@@ -14,6 +14,7 @@ void OdometryTrajectory::push(uint64_t sequence, double timestamp_s, bool valid,
   p.frame.sequence = sequence;
   p.frame.timestamp_s = timestamp_s;
   p.frame.valid = valid;
+  p.frame.dropped = false;
   p.frame.T_world_cam = T_world_cam;
   p.reference_id = valid ? reference_id : 0;
   p.T_ref_cam = T_ref_cam;

@@ -19,6 +19,7 @@ struct FinishedFrame {
   uint64_t sequence = 0;
   double timestamp_s = 0;
   bool valid = false;  // false: no pose (lost / not initialised)
+  bool dropped = false;  // never processed (real-time replay found no free slot); valid is false
   Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
 };
 
@@ -30,6 +31,11 @@ class OdometryTrajectory {
   // Adds a frame. reference_id 0 = no reference (pose used as given).
   void push(uint64_t sequence, double timestamp_s, bool valid, const Eigen::Isometry3d& T_world_cam,
             uint32_t reference_id, const Eigen::Isometry3d& T_ref_cam);
+  // A frame the runtime dropped before processing: it keeps its place in the output order.
+  void pushDropped(uint64_t sequence, double timestamp_s) {
+    push(sequence, timestamp_s, false, Eigen::Isometry3d::Identity(), 0, Eigen::Isometry3d::Identity());
+    fifo_[(head_ + size_ - 1) % kMaxDelayFrames].frame.dropped = true;
+  }
   // Frames leaving the FIFO, resolved against the keyframe poses of `map`; calls fn(FinishedFrame)
   // for each. flushAll empties the FIFO (end of run).
   template <typename Fn>

@@ -71,7 +71,9 @@ std::string formatChromeTrace(const std::vector<TraceTrack>& tracks, const RunRe
   }
   for (std::size_t tid = 0; tid < tracks.size(); ++tid) {
     const std::string name = escapeJson(tracks[tid].name());
-    const bool last = tid + 1 == tracks.size();
+    // The end-to-end spans hang on the track whose completion ends them (the last by default).
+    const bool last = report.end_to_end_stage > 0 ? tid == std::size_t(report.end_to_end_stage)
+                                                  : tid + 1 == tracks.size();
     for (const TraceRecord& r : tracks[tid].records()) {
       if (r.kind != TraceRecord::Kind::kSpan) {
         const char* what = r.kind == TraceRecord::Kind::kDrop ? "drop" : "late";

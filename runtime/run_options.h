@@ -36,6 +36,10 @@ struct RunOptions {
   // Real-time mode: frames the source reaches more than this long after their due time are
   // skipped and counted as late (the replay fell behind); <= 0: never skip.
   int64_t max_source_lag_ns = 50'000'000;
+  // Processing stage (1..N) whose completion ends a frame's end-to-end latency (t_done - t_sensor);
+  // 0 = the last stage. For plumb: tracking, when the pose is known; mapping only refines the map
+  // later frames are tracked against.
+  int end_to_end_stage = 0;
   // Trace records kept per stage (preallocated); later frames are counted, not recorded.
   std::size_t trace_capacity_per_stage = 8192;
   // Stage threads: SCHED_FIFO priority (0 = normal scheduling) and pinning to CPU (i % cores).

@@ -27,6 +27,12 @@ std::string formatRunReport(const RunReport& report) {
   out += line;
   for (const StageReport& stage : report.stages) appendRow(&out, stage.name, stage.latency);
   appendRow(&out, "end-to-end", report.end_to_end);
+  const int e2e = report.end_to_end_stage;
+  if (e2e > 0 && e2e + 1 < static_cast<int>(report.stages.size())) {
+    std::snprintf(line, sizeof(line), "end-to-end = sensor time to '%s' done (later stages not included)\n",
+                  report.stages[e2e].name.c_str());
+    out += line;
+  }
   std::snprintf(line, sizeof(line),
                 "mode %s: %llu frames read, %llu completed, %llu dropped (no free slot), %llu late "
                 "(source behind), %.3f s, %.2f frames/s\n",

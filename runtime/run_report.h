@@ -17,7 +17,8 @@ struct StageReport {
 struct RunReport {
   std::string mode;
   std::vector<StageReport> stages;  // [0] = source, then the stages in order
-  LatencyHistogram end_to_end;      // t_done(last stage) - t_sensor, per completed frame
+  LatencyHistogram end_to_end;      // t_done(end_to_end_stage) - t_sensor, per completed frame
+  int end_to_end_stage = 0;         // index into stages whose completion ends end_to_end
   uint64_t frames_read = 0;         // frames the source put into slots
   uint64_t frames_completed = 0;    // frames every stage processed
   uint64_t frames_dropped = 0;      // real-time mode: frames that found no free slot

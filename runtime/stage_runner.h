@@ -124,6 +124,10 @@ class StageRunner {
 
   bool realtime() const { return options_.mode == RunMode::kRealtime; }
   int lastStage() const { return stageCount(); }
+  int endToEndStage() const {
+    const int s = options_.end_to_end_stage;
+    return s >= 1 && s <= lastStage() ? s : lastStage();
+  }
 
   // Recording time -> run-clock time: the first frame is due now, the others keep their spacing.
   int64_t pacedTimeNs(int64_t t_recorded_ns) {
@@ -197,7 +201,7 @@ class StageRunner {
     if (m.kind != Kind::kFrame) return;
     const FrameStamps& stamps = pool_[m.slot].stamps;
     const int64_t t_done = stamps.t_done_ns[lastStage()];
-    report_.end_to_end.add(t_done - stamps.t_sensor_ns);
+    report_.end_to_end.add(stamps.t_done_ns[endToEndStage()] - stamps.t_sensor_ns);
     ++report_.frames_completed;
     t_last_done_ns_ = std::max(t_last_done_ns_, t_done);
   }

@@ -188,6 +188,7 @@ Status StageRunner<T>::finishReport() {
   for (int s = 0; s <= lastStage(); ++s) {
     report_.stages.push_back({tracks_[s].name(), state_[s].latency});
   }
+  report_.end_to_end_stage = endToEndStage();
   report_.wall_ns = report_.frames_completed > 0 ? t_last_done_ns_ - t_first_start_ns_ : 0;
   for (int s = 0; s <= lastStage(); ++s) {
     if (!state_[s].error.ok()) return state_[s].error.withContext("stage " + tracks_[s].name());

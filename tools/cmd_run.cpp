@@ -1,8 +1,9 @@
 // plumb run: the odometry system over a dataset folder or a synthetic scene, writing the
-// trajectory (TUM format, lost frames as `# <timestamp> lost`), optionally keyframe covariances
-// and statistics, and the ATE when ground truth is at hand. Same input -> same output bytes.
-// Single-threaded by default; --mode runs the same system as runtime stages (tools/staged_run.h),
-// where deterministic and fast give the single-threaded bytes and realtime may drop frames.
+// trajectory (TUM format, lost frames as `# <timestamp> lost`, frames real-time mode dropped as
+// `# <timestamp> dropped`), optionally keyframe covariances and statistics, and the ATE when ground
+// truth is at hand. Same input -> same output bytes. Single-threaded by default; --mode runs the
+// same system as runtime stages (tools/staged_run.h), where deterministic gives the single-threaded
+// bytes, fast tracks against a map one keyframe behind at times, and realtime may drop frames.
 #include <cstdio>
 #include <memory>
 #include <set>
@@ -142,7 +143,7 @@ int runRun(int argc, char** argv) {
     st = readTumTrajectory(args.get("gt"), &ground_truth).withContext("reading ground truth");
     if (!st.ok()) return fail(st.message());
   } else if (scene != nullptr) {
-    ground_truth = syntheticGroundTruth(*scene, result.frames);
+    ground_truth = syntheticGroundTruth(*scene, result.frames + result.frames_dropped);
   }
   if (!ground_truth.empty() && options.keep_trajectory) {
     st = ateRmse(ground_truth, result.trajectory, &ate);

@@ -117,6 +117,7 @@ Status runSession(FrameSource& source, const SessionOptions& options, SessionRes
     pose.timestamp = f.timestamp_s;
     pose.T_world_cam = f.T_world_cam;
     pose.valid = f.valid;
+    pose.dropped = f.dropped;
     if (options.keep_trajectory) result->trajectory.push_back(pose);
     if (!options.trajectory_path.empty() && write_status.ok()) write_status = trajectory_writer.append(pose);
   };
@@ -126,6 +127,11 @@ Status runSession(FrameSource& source, const SessionOptions& options, SessionRes
   // it runs on the odometry stage's thread, in frame order): statistics, drained output, checks.
   uint64_t allocations_at_warmup = 0;
   auto after_frame = [&](const FrameOutput& out) -> Status {
+    if (out.dropped) {  // realtime: only its place in the trajectory (`# <t> dropped`)
+      ++result->frames_dropped;
+      system->drainFinishedFrames(on_frame);
+      return write_status;
+    }
     ++result->frames;
     result->extract_ms.add(out.extract_ms);
     result->track_ms.add(out.track_ms);

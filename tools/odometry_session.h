@@ -60,6 +60,7 @@ struct RssCheckpoint {
 struct SessionResult {
   std::vector<StampedPose> trajectory;  // when keep_trajectory
   long frames = 0;
+  long frames_dropped = 0;  // realtime mode: written as `# <timestamp> dropped`, not in `frames`
   MsHistogram total_ms, extract_ms, track_ms, map_ms;
   OdometryStats stats;
   MapperStats mapper;

@@ -10,6 +10,9 @@
 #include "pipeline/feature_extractor.h"
 #include "platform/allocation_counter.h"
 #include "runtime/chrome_trace.h"
+#include "runtime/clock.h"
+#include "runtime/doorbell.h"
+#include "runtime/spsc_ring.h"
 #include "runtime/stage_runner.h"
 
 namespace plumb::tools {
@@ -18,14 +21,37 @@ namespace {
 
 // Set by the capture stage when its source has no more frames. From then on the stage threads
 // wind down, and a thread's exit allocates inside OpenCV's thread-local-storage cleanup: teardown,
-// not per-frame cost, so the steady-state allocation window closes here (see OdometryStage).
+// not per-frame cost, so the steady-state allocation window closes here (see MapStage).
 using InputEnded = std::atomic<bool>;
+
+// Frames the capture stage skipped (real-time: no free slot, or the source fell behind), on their
+// way to the map stage, which writes them into the output trajectory in order: each slot says how
+// many were skipped just before it; the rest are those after the last frame. Capacity: a stall of
+// ~34 s at 30 Hz; beyond it a dropped frame gets no trajectory line (counted).
+struct DroppedFrame {
+  uint64_t sequence = 0;
+  double timestamp_s = 0;
+};
+struct DropLog {
+  static constexpr std::size_t kCapacity = 1024;
+  runtime::SpscRing<DroppedFrame> ring{kCapacity};
+  uint64_t not_logged = 0;  // capture thread only
+
+  // Capture side; true when the drop will reach the map stage.
+  bool log(uint64_t sequence, double timestamp_s) {
+    if (ring.try_push(DroppedFrame{sequence, timestamp_s})) return true;
+    ++not_logged;
+    return false;
+  }
+};
 
 // What one slot carries through the stages. FrameFeatures is large (fixed capacities), so it lives
 // on the heap, allocated once with the slot.
 struct OdometrySlot {
   RgbdImage image;
   std::unique_ptr<FrameFeatures> features = std::make_unique<FrameFeatures>();
+  std::unique_ptr<TrackedFrame> tracked = std::make_unique<TrackedFrame>();  // track -> map
+  uint32_t dropped_before = 0;  // DropLog entries that precede this frame
 };
 
 // Stage 0. FrameSource has no "peek", so the next frame is read ahead into a staging image; read()
@@ -35,8 +61,8 @@ struct OdometrySlot {
 // finished frame.
 class CaptureStage final : public runtime::Source<OdometrySlot> {
  public:
-  CaptureStage(FrameSource& source, long max_frames, InputEnded& input_ended)
-      : source_(source), max_frames_(max_frames), input_ended_(input_ended) {}
+  CaptureStage(FrameSource& source, long max_frames, InputEnded& input_ended, DropLog& drops)
+      : source_(source), max_frames_(max_frames), input_ended_(input_ended), drops_(drops) {}
 
   bool peekNext(int64_t* t_recorded_ns) override {
     if (staged_) {
@@ -68,12 +94,15 @@ class CaptureStage final : public runtime::Source<OdometrySlot> {
     if (!error_.ok()) return error_;
     std::swap(slot.image, staging_);
     slot.image.t_sensor_ns = stamps.t_sensor_ns;
+    slot.dropped_before = dropped_since_read_;
+    dropped_since_read_ = 0;
     return Status::Ok();
   }
 
   void skip() override {
     staged_ = false;
     ++consumed_;
+    if (error_.ok()) dropped_since_read_ += drops_.log(staging_.sequence, staging_.timestamp_s);
   }
 
  private:
@@ -85,6 +114,8 @@ class CaptureStage final : public runtime::Source<OdometrySlot> {
   FrameSource& source_;
   long max_frames_;
   InputEnded& input_ended_;
+  DropLog& drops_;
+  uint32_t dropped_since_read_ = 0;
   long consumed_ = 0;
   RgbdImage staging_;
   bool staged_ = false;
@@ -99,8 +130,8 @@ class CaptureStage final : public runtime::Source<OdometrySlot> {
 // frame rate; this one only decodes what it delivers.
 class TumReplayCapture final : public runtime::Source<OdometrySlot> {
  public:
-  TumReplayCapture(TumDatasetSource& replay, long max_frames, InputEnded& input_ended)
-      : replay_(replay), max_frames_(max_frames), input_ended_(input_ended) {}
+  TumReplayCapture(TumDatasetSource& replay, long max_frames, InputEnded& input_ended, DropLog& drops)
+      : replay_(replay), max_frames_(max_frames), input_ended_(input_ended), drops_(drops) {}
 
   bool peekNext(int64_t* t_recorded_ns) override {
     const bool at_end =
@@ -115,14 +146,21 @@ class TumReplayCapture final : public runtime::Source<OdometrySlot> {
   Status read(OdometrySlot& slot, const runtime::FrameStamps& stamps) override {
     const Status status = replay_.load(next_++, slot.image);
     slot.image.t_sensor_ns = stamps.t_sensor_ns;
+    slot.dropped_before = dropped_since_read_;
+    dropped_since_read_ = 0;
     return status;
   }
-  void skip() override { ++next_; }
+  void skip() override {
+    dropped_since_read_ += drops_.log(next_, replay_.timestamp(next_));
+    ++next_;
+  }
 
  private:
   TumDatasetSource& replay_;
   long max_frames_;
   InputEnded& input_ended_;
+  DropLog& drops_;
+  uint32_t dropped_since_read_ = 0;
   std::size_t next_ = 0;  // the replay's own cursor is not used: load() is random access
 };
 
@@ -147,17 +185,62 @@ class ExtractStage final : public runtime::Stage<OdometrySlot> {
   uint64_t failures_ = 0;
 };
 
-// Stage 2: tracking, keyframe decision and local mapping, in frame order.
-class OdometryStage final : public runtime::Stage<OdometrySlot> {
+// How far the map stage has got, for the track stage's MapperFence. Written by the map stage's
+// thread after each frame (release), read by the track stage's (acquire).
+struct MapperProgress {
+  std::atomic<uint64_t> frames_mapped{0};
+  std::atomic<bool> failed{false};  // the map stage stopped: nobody to wait for
+  runtime::Doorbell bell;           // rung after every change above
+};
+
+// Stage 2: tracking and the keyframe decision. The keyframe request travels in the slot.
+class TrackStage final : public runtime::Stage<OdometrySlot>, public MapperFence {
  public:
-  OdometryStage(OdometrySystem& system, const FrameOutputFn& on_output, uint64_t warmup_frames,
-                const InputEnded& input_ended)
-      : system_(system), on_output_(on_output), warmup_frames_(warmup_frames), input_ended_(input_ended) {}
-  const char* name() const override { return "odometry"; }
+  // threaded: false for lock-step and for the single-threaded simulation of realtime mode on a
+  // VirtualClock, where nobody else could move the map stage on (the simulation runs each step to
+  // completion in virtual-time order, so the map stage may "later" map an earlier frame).
+  TrackStage(OdometrySystem& system, MapperProgress& progress, bool threaded)
+      : system_(system), progress_(progress), threaded_(threaded) {}
+  const char* name() const override { return "track"; }
+  Status process(OdometrySlot& slot, const runtime::FrameStamps&) override {
+    system_.trackFeatures(*slot.features, slot.image.sequence, slot.image.timestamp_s, this, slot.tracked.get());
+    ++frames_tracked_;
+    return Status::Ok();
+  }
+  // Called (rarely: map start, relocalization) while frame frames_tracked_ is being tracked: the
+  // map stage has done every earlier frame once frames_mapped reaches frames_tracked_. In lock-step
+  // runs that is always already true.
+  void waitForMapper() override {
+    if (!threaded_) return;
+    progress_.bell.waitUntil([this] {
+      return progress_.failed.load(std::memory_order_acquire) ||
+             progress_.frames_mapped.load(std::memory_order_acquire) >= frames_tracked_;
+    });
+  }
+
+ private:
+  OdometrySystem& system_;
+  MapperProgress& progress_;
+  bool threaded_;
+  uint64_t frames_tracked_ = 0;
+};
+
+// Stage 3: local mapping for keyframe requests, output trajectory, the caller's bookkeeping.
+class MapStage final : public runtime::Stage<OdometrySlot> {
+ public:
+  MapStage(OdometrySystem& system, MapperProgress& progress, DropLog& drops, const FrameOutputFn& on_output,
+           uint64_t warmup_frames, const InputEnded& input_ended)
+      : system_(system),
+        progress_(progress),
+        drops_(drops),
+        on_output_(on_output),
+        warmup_frames_(warmup_frames),
+        input_ended_(input_ended) {}
+  const char* name() const override { return "map"; }
   Status process(OdometrySlot& slot, const runtime::FrameStamps& stamps) override {
-    const FrameOutput& out =
-        system_.processFeatures(*slot.features, slot.image.sequence, slot.image.timestamp_s);
-    Status status = on_output_ ? on_output_(out) : Status::Ok();
+    Status status = writeDrops(slot.dropped_before);
+    const FrameOutput& out = system_.mapFrame(*slot.tracked);
+    if (status.ok() && on_output_) status = on_output_(out);
     // Process-wide count, read on this thread after each frame: from the first frame at or after
     // warm-up to the last one finished before the input ended, every thread's allocations are
     // included. The count is read before the flag, so a reading taken after a stage thread began
@@ -170,13 +253,39 @@ class OdometryStage final : public runtime::Stage<OdometrySlot> {
         ++frames_after_warmup_;
       }
     }
+    // Last: the mapper, relocalizer and system outputs are released to a waiting track stage.
+    if (!status.ok()) progress_.failed.store(true, std::memory_order_release);
+    progress_.frames_mapped.fetch_add(1, std::memory_order_release);
+    progress_.bell.ring();
     return status;
   }
+  // Frames dropped after the last processed one (the capture thread has finished: it sent the end
+  // of stream this call follows).
+  void finish() override {
+    const Status status = writeDrops(UINT32_MAX);
+    if (finish_status_.ok()) finish_status_ = status;
+  }
+  const Status& finishStatus() const { return finish_status_; }
   uint64_t framesAfterWarmup() const { return frames_after_warmup_; }
   uint64_t allocationsAfterWarmup() const { return allocations_at_last_ - allocations_at_warmup_; }
 
  private:
+  // Up to `count` logged drops into the output trajectory, in order, through the caller's callback
+  // (which drains the trajectory, so its delay FIFO never holds more than one burst).
+  Status writeDrops(uint32_t count) {
+    Status status;
+    DroppedFrame dropped;
+    for (uint32_t i = 0; i < count && drops_.ring.try_pop(dropped); ++i) {
+      const FrameOutput& out = system_.mapDroppedFrame(dropped.sequence, dropped.timestamp_s);
+      if (status.ok() && on_output_) status = on_output_(out);
+    }
+    return status;
+  }
+
   OdometrySystem& system_;
+  MapperProgress& progress_;
+  DropLog& drops_;
+  Status finish_status_;
   const FrameOutputFn& on_output_;
   uint64_t warmup_frames_;
   const InputEnded& input_ended_;
@@ -191,29 +300,39 @@ Status runStaged(FrameSource& source, OdometrySystem& system, const StagedRunOpt
                  const FrameOutputFn& on_output, StagedRunResult* result) {
   // A TUM replay is read by index (cheap peek/skip); any other source through next() + read-ahead.
   InputEnded input_ended{false};
-  CaptureStage generic_capture(source, options.max_frames, input_ended);
+  DropLog drops;
+  CaptureStage generic_capture(source, options.max_frames, input_ended, drops);
   auto* replay = dynamic_cast<TumDatasetSource*>(&source);
   std::unique_ptr<TumReplayCapture> replay_capture;
   if (replay != nullptr) {
-    replay_capture = std::make_unique<TumReplayCapture>(*replay, options.max_frames, input_ended);
+    replay_capture = std::make_unique<TumReplayCapture>(*replay, options.max_frames, input_ended, drops);
   }
   runtime::Source<OdometrySlot>& capture =
       replay_capture ? static_cast<runtime::Source<OdometrySlot>&>(*replay_capture) : generic_capture;
   ExtractStage extract(system.extractor());
-  OdometryStage odometry(system, on_output, options.warmup_frames, input_ended);
+  MapperProgress progress;
+  const bool simulated = options.mode == runtime::RunMode::kRealtime && options.clock != nullptr &&
+                         options.clock->isVirtual();
+  TrackStage track(system, progress, options.mode != runtime::RunMode::kDeterministic && !simulated);
+  MapStage map(system, progress, drops, on_output, options.warmup_frames, input_ended);
   runtime::RunOptions run_options;
   run_options.mode = options.mode;
   run_options.slot_count = options.slot_count;
   run_options.realtime_priority = options.realtime_priority;
   run_options.pin_threads = options.pin_threads;
   run_options.lock_memory = options.lock_memory;
-  runtime::StageRunner<OdometrySlot> runner(capture, {&extract, &odometry}, run_options);
-  const Status status = runner.run();
+  run_options.clock = options.clock;
+  // End to end = sensor time to pose known (track done); the map stage refines later frames' map.
+  run_options.end_to_end_stage = 2;
+  runtime::StageRunner<OdometrySlot> runner(capture, {&extract, &track, &map}, run_options);
+  Status status = runner.run();
+  if (status.ok()) status = map.finishStatus();
 
   result->report = runner.report();
   result->extraction_failures = extract.failures();
-  result->frames_after_warmup = odometry.framesAfterWarmup();
-  result->allocations_after_warmup = odometry.allocationsAfterWarmup();
+  result->drops_without_trajectory_line = drops.not_logged;
+  result->frames_after_warmup = map.framesAfterWarmup();
+  result->allocations_after_warmup = map.allocationsAfterWarmup();
   if (!options.profile_path.empty()) {
     PLUMB_RETURN_IF_ERROR(runtime::writeChromeTrace(options.profile_path, runner.trace(), runner.report()));
     if (options.print_profile) {

@@ -83,9 +83,9 @@ Status runMode(const std::string& dir, long frames, runtime::RunMode mode, const
   options.max_frames = frames;
   options.profile_path = trace;
   options.print_profile = false;
-  const tools::FrameOutputFn on_output = [&](const FrameOutput&) {
+  const tools::FrameOutputFn on_output = [&](const FrameOutput& output) {
     system.drainFinishedFrames(on_frame);
-    ++out->frames;
+    if (!output.dropped) ++out->frames;
     return Status::Ok();
   };
   const int64_t start = monotonicNowNs();

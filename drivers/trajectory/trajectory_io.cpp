@@ -96,7 +96,7 @@ std::size_t formatTumLine(const StampedPose& pose, char* buffer, std::size_t buf
   if (buffer_size == 0) return 0;
   int written = 0;
   if (!pose.valid) {
-    written = std::snprintf(buffer, buffer_size, "# %.6f lost", pose.timestamp);
+    written = std::snprintf(buffer, buffer_size, pose.dropped ? "# %.6f dropped" : "# %.6f lost", pose.timestamp);
   } else {
     const Eigen::Vector3d t = pose.T_world_cam.translation();
     Eigen::Quaterniond q(pose.T_world_cam.rotation());

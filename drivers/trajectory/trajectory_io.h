@@ -19,6 +19,7 @@ struct StampedPose {
   double timestamp = 0;
   Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
   bool valid = true;  // false: the frame had no pose (written as `# <timestamp> lost`)
+  bool dropped = false;  // with !valid: the frame was never processed (real-time drop), `# <timestamp> dropped`
 };
 
 struct TrajectoryReadOptions {

@@ -1,0 +1,90 @@
+// Real-time mode on a VirtualClock (tools/staged_run.h): the map stage made slow on one frame fills
+// every slot, exactly the frames that arrive meanwhile are dropped, and each dropped frame keeps its
+// place in the output trajectory as `# <timestamp> dropped`.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "drivers/synth/synthetic_scene.h"
+#include "drivers/trajectory/trajectory_io.h"
+#include "pipeline/odometry_system.h"
+#include "runtime/clock.h"
+#include "tools/staged_run.h"
+
+namespace plumb {
+namespace {
+
+constexpr int kFrames = 40;
+constexpr int kSlowFrame = 10;
+constexpr int64_t kSlowNs = 190'000'000;  // 5.7 frame periods at 30 Hz
+
+struct DropRun {
+  std::vector<FinishedFrame> frames;  // the output trajectory, in output order
+  tools::StagedRunResult result;
+  std::vector<double> source_timestamps;
+};
+
+// Every stage takes no virtual time except the map stage on kSlowFrame (its on_output runs inside
+// the map stage's step, so advancing the clock there makes that step long).
+void runWithSlowMapStage(DropRun* run) {
+  SynthOptions synth;
+  synth.preset = "textured";
+  synth.frames = kFrames;
+  std::unique_ptr<SyntheticSource> source;
+  ASSERT_TRUE(SyntheticSource::create(synth, &source).ok());
+  for (int i = 0; i < kFrames; ++i) run->source_timestamps.push_back(source->scene().timestamp(i));
+
+  OdometrySystem system(source->camera(), SystemOptions{});
+  runtime::VirtualClock clock;
+  tools::StagedRunOptions options;
+  options.mode = runtime::RunMode::kRealtime;
+  options.clock = &clock;
+  options.slot_count = 4;
+  auto keep = [run](const FinishedFrame& f) { run->frames.push_back(f); };
+  int processed = 0;
+  const tools::FrameOutputFn on_output = [&](const FrameOutput& out) {
+    if (!out.dropped && processed++ == kSlowFrame) clock.advanceNs(kSlowNs);
+    system.drainFinishedFrames(keep);
+    return Status::Ok();
+  };
+  const Status status = tools::runStaged(*source, system, options, on_output, &run->result);
+  ASSERT_TRUE(status.ok()) << status.message();
+  system.finish(keep, [](const RetiredKeyframe&) {});
+}
+
+TEST(StagedDrops, SlowMapStageDropsExactlyTheFramesThatFindNoSlot) {
+  DropRun run;
+  runWithSlowMapStage(&run);
+  // Frame 10 holds the map stage from 333 ms to 523 ms; frames 11..13 fill the other three slots,
+  // so 14 (467 ms) and 15 (500 ms) find none; 16 (533 ms) finds the slots freed at 523 ms.
+  EXPECT_EQ(run.result.report.frames_dropped, 2u);
+  EXPECT_EQ(run.result.report.frames_late, 0u);
+  EXPECT_EQ(run.result.report.frames_completed, uint64_t(kFrames - 2));
+  EXPECT_EQ(run.result.drops_without_trajectory_line, 0u);
+
+  // One output line per source frame, in source order; the dropped ones are exactly 14 and 15.
+  ASSERT_EQ(run.frames.size(), std::size_t(kFrames));
+  for (int i = 0; i < kFrames; ++i) {
+    EXPECT_DOUBLE_EQ(run.frames[std::size_t(i)].timestamp_s, run.source_timestamps[std::size_t(i)]) << i;
+    const bool expect_dropped = i == 14 || i == 15;
+    EXPECT_EQ(run.frames[std::size_t(i)].dropped, expect_dropped) << i;
+    if (expect_dropped) {
+      EXPECT_FALSE(run.frames[std::size_t(i)].valid) << i;
+    }
+  }
+}
+
+TEST(StagedDrops, DroppedFrameIsWrittenAsADroppedComment) {
+  StampedPose pose;
+  pose.timestamp = 1000.5;
+  pose.valid = false;
+  pose.dropped = true;
+  EXPECT_EQ(formatTumLine(pose), "# 1000.500000 dropped");
+  pose.dropped = false;
+  EXPECT_EQ(formatTumLine(pose), "# 1000.500000 lost");
+}
+
+}  // namespace
+}  // namespace plumb
