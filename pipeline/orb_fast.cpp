@@ -64,82 +64,81 @@ void FastDetector::scan(int threshold, int x0, int y0, int x1, int y1) {
   const int x_end = std::min(x1, image.cols - border_), y_end = std::min(y1, image.rows - border_);
   threshold = std::clamp(threshold, 1, 254);
 
-  const int compass[4] = {-3 * stride, 3, 3 * stride, -3};
   int circle[16];
   for (int k = 0; k < 16; ++k) circle[k] = kCircleY[k] * stride + kCircleX[k];
+  // Unsigned byte comparisons as signed ones on values with the top bit flipped (SSE2 only has
+  // signed byte compares): a > b  <=>  (a ^ 0x80) > (b ^ 0x80).
   const cv::v_uint8x16 t = cv::v_setall_u8(static_cast<uint8_t>(threshold));
-  const cv::v_uint8x16 one = cv::v_setall_u8(1), two = cv::v_setall_u8(2), four = cv::v_setall_u8(4);
+  const cv::v_int8x16 sign = cv::v_setall_s8(-128);
+  auto flip = [&sign](const cv::v_uint8x16& v) { return cv::v_reinterpret_as_s8(v) ^ sign; };
+  const cv::v_int8x16 nine = cv::v_setall_s8(9);
   auto record = [&](uint8_t* score_row, int x, int y, int score) {
     if (score <= threshold) return;
     score_row[x] = static_cast<uint8_t>(std::min(score, 255));
     if (num_raw_ < capacity_) raw_[num_raw_++] = FastCorner{int16_t(x), int16_t(y), uint8_t(std::min(score, 255))};
     else ++dropped_;
   };
+  // Max over the 16 cyclic arcs of 9 of the minimum of `diff` over the arc, by doubling:
+  // min over 2, 4, 8 consecutive, then the 9th.
+  auto arcScore = [](const cv::v_uint8x16* diff, cv::v_uint8x16 score) {
+    cv::v_uint8x16 m2[16], m4[16];
+    for (int k = 0; k < 16; ++k) m2[k] = cv::v_min(diff[k], diff[(k + 1) & 15]);
+    for (int k = 0; k < 16; ++k) m4[k] = cv::v_min(m2[k], m2[(k + 2) & 15]);
+    for (int k = 0; k < 16; ++k) {
+      score = cv::v_max(score, cv::v_min(cv::v_min(m4[k], m4[(k + 4) & 15]), diff[(k + 8) & 15]));
+    }
+    return score;
+  };
+  const int block_end = x_end - x0 >= 16 ? x_end : x0;  // rows narrower than a block: scalar only
   for (int y = y0; y < y_end; ++y) {
     const uint8_t* row = image.ptr<uint8_t>(y);
     uint8_t* score_row = score_.ptr<uint8_t>(y);
-    // One block of 16 pixels starting at bx; lanes below `first_lane` were done already.
-    auto block = [&](int bx, int first_lane) {
+    // Blocks of 16 pixels; the last one is moved back to end at x_end, and its lanes below
+    // `first_lane` (done by the previous block) are ignored.
+    for (int x = x0; x < block_end;) {
+      const int bx = std::min(x, block_end - 16);
+      const int first_lane = x - bx;
+      x = bx + 16;
       const cv::v_uint8x16 c = cv::v_load(row + bx);
-      const cv::v_uint8x16 hi = c + t, lo = c - t;  // saturating
-      // Rejection test: an arc of 9 of 16 always covers at least two of the four compass
-      // pixels, so a corner needs >= 2 of them brighter (or darker) than the centre.
-      cv::v_uint8x16 bright = cv::v_setzero_u8(), dark = cv::v_setzero_u8();
-      for (int k = 0; k < 4; ++k) {
-        const cv::v_uint8x16 q = cv::v_load(row + bx + compass[k]);
-        bright += (q > hi) & one;
-        dark += (q < lo) & one;
-      }
-      cv::v_uint8x16 maybe = (bright >= two) | (dark >= two);
-      if (!cv::v_check_any(maybe)) return;
-      // Second filter on the four diagonal-ish even pixels: an arc of 9 covers >= 4 of the 8 even
-      // circle positions, so a corner needs >= 4 of them on one side.
-      for (int k = 2; k < 16; k += 4) {
-        const cv::v_uint8x16 q = cv::v_load(row + bx + circle[k]);
-        bright += (q > hi) & one;
-        dark += (q < lo) & one;
-      }
-      maybe = (bright >= four) | (dark >= four);
-      if (!cv::v_check_any(maybe)) return;
-      // Third filter, the full count: an arc of 9 needs >= 9 of all 16 pixels on one side. It
+      const cv::v_int8x16 hi = flip(c + t), lo = flip(c - t);  // saturating
+      // Rejection test on the compass pixels 0, 4, 8, 12: an arc of 9 of the 16 always covers
+      // two neighbouring ones (0-4, 4-8, 8-12 or 12-0), i.e. (p0 or p8) and (p4 or p12).
+      const cv::v_int8x16 n = flip(cv::v_load(row + bx + circle[0])), e = flip(cv::v_load(row + bx + circle[4]));
+      const cv::v_int8x16 s = flip(cv::v_load(row + bx + circle[8])), w = flip(cv::v_load(row + bx + circle[12]));
+      const cv::v_int8x16 maybe = (((n > hi) | (s > hi)) & ((e > hi) | (w > hi))) |
+                                  (((n < lo) | (s < lo)) & ((e < lo) | (w < lo)));
+      if (!cv::v_check_any(maybe)) continue;
+      // Second filter, the full count: an arc of 9 needs >= 9 of the 16 pixels on one side. It
       // also tells which sides can still have a corner, so only those get scored below.
       cv::v_uint8x16 q[16];
-      for (int k = 0; k < 16; ++k) q[k] = cv::v_load(row + bx + circle[k]);
-      for (int k = 1; k < 16; k += 2) {
-        bright += (q[k] > hi) & one;
-        dark += (q[k] < lo) & one;
+      cv::v_int8x16 bright = cv::v_setzero_s8(), dark = cv::v_setzero_s8();
+      for (int k = 0; k < 16; ++k) {
+        q[k] = cv::v_load(row + bx + circle[k]);
+        const cv::v_int8x16 f = flip(q[k]);
+        bright -= (f > hi);  // a true comparison is -1
+        dark -= (f < lo);
       }
-      const cv::v_uint8x16 nine = cv::v_setall_u8(9);
-      const cv::v_uint8x16 maybe_bright = (bright >= nine) & maybe, maybe_dark = (dark >= nine) & maybe;
+      const cv::v_int8x16 maybe_bright = (bright >= nine) & maybe, maybe_dark = (dark >= nine) & maybe;
       const bool any_bright = cv::v_check_any(maybe_bright), any_dark = cv::v_check_any(maybe_dark);
-      if (!any_bright && !any_dark) return;
-      maybe = maybe_bright | maybe_dark;
+      if (!any_bright && !any_dark) continue;
       // Score in saturating u8 arithmetic: with b_k = sat(I_k - c) and e_k = sat(c - I_k), the
       // score is the max over the 16 arcs of 9 of min(b) (bright side) or min(e) (dark side); a
       // pixel is a corner exactly when its score exceeds the threshold (the segment test). Arcs
       // of 9 of 16 cannot be bright and dark at once, so a corner's score is that of the side
       // that passed the count: a side no lane can pass is skipped without changing any score.
-      auto sideScore = [](const cv::v_uint8x16* diff, cv::v_uint8x16 score) {
-        cv::v_uint8x16 d2[31];
-        for (int k = 0; k < 31; ++k) d2[k] = cv::v_min(diff[k & 15], diff[(k + 1) & 15]);
-        for (int k = 0; k < 16; ++k) {
-          const cv::v_uint8x16 d4a = cv::v_min(d2[k], d2[k + 2]), d4b = cv::v_min(d2[k + 4], d2[k + 6]);
-          score = cv::v_max(score, cv::v_min(cv::v_min(d4a, d4b), diff[(k + 8) & 15]));
-        }
-        return score;
-      };
       cv::v_uint8x16 score = cv::v_setzero_u8();
       cv::v_uint8x16 diff[16];
       if (any_bright) {
         for (int k = 0; k < 16; ++k) diff[k] = q[k] - c;
-        score = sideScore(diff, score);
+        score = arcScore(diff, score);
       }
       if (any_dark) {
         for (int k = 0; k < 16; ++k) diff[k] = c - q[k];
-        score = sideScore(diff, score);
+        score = arcScore(diff, score);
       }
-      int mask = cv::v_signmask((score > t) & maybe) & (0xFFFF << first_lane);
-      if (!mask) return;
+      const cv::v_uint8x16 candidates = cv::v_reinterpret_as_u8(maybe_bright | maybe_dark);
+      int mask = cv::v_signmask((score > t) & candidates) & (0xFFFF << first_lane);
+      if (!mask) continue;
       uint8_t lane_score[16];
       cv::v_store(lane_score, score);
       while (mask) {
@@ -147,14 +146,10 @@ void FastDetector::scan(int threshold, int x0, int y0, int x1, int y1) {
         mask &= mask - 1;
         record(score_row, bx + lane, y, lane_score[lane]);
       }
-    };
-    int x = x0;
-    for (; x + 16 <= x_end; x += 16) block(x, 0);
-    if (x < x_end && x_end - x0 >= 16) {
-      block(x_end - 16, 16 - (x_end - x));  // overlapping last block, only its new lanes
-      x = x_end;
     }
-    for (; x < x_end; ++x) record(score_row, x, y, fastScore(row + x, stride));  // tail
+    for (int x = block_end > x0 ? x_end : x0; x < x_end; ++x) {
+      record(score_row, x, y, fastScore(row + x, stride));  // rows narrower than one block
+    }
   }
 }
 
