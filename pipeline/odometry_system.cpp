@@ -108,6 +108,8 @@ void OdometrySystem::tryRelocalize(const FrameFeatures& features, MapperFence* f
 void OdometrySystem::trackFeatures(const FrameFeatures& features, uint64_t sequence, double timestamp_s,
                                    MapperFence* fence, TrackedFrame* out) {
   const auto start = std::chrono::steady_clock::now();
+  // Read before installing: a request reported done has its snapshot published already.
+  const bool request_pending = keyframe_requests_done_.load(std::memory_order_acquire) < keyframe_requests_;
   installNewestSnapshot();
   FrameOutput& o = out->output;
   o = FrameOutput{};
@@ -128,7 +130,7 @@ void OdometrySystem::trackFeatures(const FrameFeatures& features, uint64_t seque
       startMap(features, sequence, timestamp_s, T_world_last_good_, fence, out);
     }
   } else {
-    o.track = tracker_->track(features, sequence, timestamp_s, &out->request);
+    o.track = tracker_->track(features, sequence, timestamp_s, request_pending ? nullptr : &out->request);
     o.state = o.track.state;
     if (o.state == TrackingState::kLost) {
       lost_ = true;
@@ -141,6 +143,7 @@ void OdometrySystem::trackFeatures(const FrameFeatures& features, uint64_t seque
       out->reference_id = snapshot.reference_keyframe_id;
       out->T_ref_cam = snapshot.T_world_reference.inverse() * o.T_world_cam;
       out->map_keyframe = o.track.keyframe_requested;
+      keyframe_requests_ += out->map_keyframe;
     }
   }
   if (!o.has_pose && map_started_) o.state = TrackingState::kLost;
@@ -172,6 +175,7 @@ const FrameOutput& OdometrySystem::mapFrame(const TrackedFrame& tracked) {
   if (tracked.map_keyframe) {
     const auto map_start = std::chrono::steady_clock::now();
     insertKeyframe(tracked.request);
+    keyframe_requests_done_.fetch_add(1, std::memory_order_release);
     output_.map_ms = millisecondsSince(map_start);
     if (output_.keyframe) {
       reference_id = output_.insert.keyframe_id;

@@ -22,9 +22,14 @@
 // every earlier frame has been through mapFrame() (the mapping thread is then idle until this frame
 // reaches it), so the two threads never touch the mapper or relocalizer at the same time. In
 // lock-step (and in processFeatures) the fence never waits and every frame sees exactly the
-// single-threaded map; threaded runs track against the newest snapshot published so far.
+// single-threaded map; threaded runs track against the newest snapshot published so far, and while
+// a keyframe request is still with the mapper the tracker makes no keyframe decision (ORB-SLAM's
+// "local mapping busy"): it would judge against a map that lacks the pending keyframe and ask for
+// near-duplicates. In lock-step a request is always done before the next frame, so this never
+// applies there.
 // Output: finished frames (reference-keyframe relative, see OdometryTrajectory) and retired
 // keyframes with their covariance, drained by the caller on the mapping side.
+#include <atomic>
 #include <cstdint>
 #include <memory>
 
@@ -152,7 +157,9 @@ class OdometrySystem {
   bool lost_ = false;
   int lost_streak_ = 0;
   Eigen::Isometry3d T_world_last_good_ = Eigen::Isometry3d::Identity();
+  uint64_t keyframe_requests_ = 0;  // handed to mapFrame()
   // Mapping side state.
+  std::atomic<uint64_t> keyframe_requests_done_{0};  // after the snapshot is published (release)
   OdometryTrajectory trajectory_;
   OdometryStats stats_;
   FrameOutput output_;
