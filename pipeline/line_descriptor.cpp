@@ -47,8 +47,12 @@ void computeLineDescriptor(const cv::Mat& image, const cv::Point2f& start, const
       const float g_across = weight * (gx * nx + gy * ny);
       const float g_along = weight * (gx * ux + gy * uy);
       float* s = stats.data() + (2 * k >= positions ? 4 : 0);
-      if (g_across > 0) s[0] += g_across; else s[1] -= g_across;
-      if (g_along > 0) s[2] += g_along; else s[3] -= g_along;
+      // Branch-free (gradient signs are random, so branches mispredict): adding +0 to the other
+      // sum leaves it unchanged, so the sums are exactly those of the if/else form.
+      s[0] += std::max(g_across, 0.f);
+      s[1] -= std::min(g_across, 0.f);
+      s[2] += std::max(g_along, 0.f);
+      s[3] -= std::min(g_along, 0.f);
     }
   }
 

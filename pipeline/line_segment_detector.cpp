@@ -26,6 +26,8 @@ LineSegmentDetector::LineSegmentDetector(int max_width, int max_height, const Li
   region_.resize(n);
   region_x_.resize(n);
   region_y_.resize(n);
+  candidate_.resize(n);
+  candidate_bin_.resize(n);
 }
 
 int LineSegmentDetector::detect(const cv::Mat& image, float min_length, DetectedSegment* out, int capacity) {
@@ -93,34 +95,50 @@ int LineSegmentDetector::detect(const cv::Mat& image, float min_length, Detected
   max_magnitude = std::max(max_magnitude, cv::v_reduce_max(v_max));
   if (max_magnitude <= threshold) return 0;
 
-  // Bucket sort of candidate pixels by magnitude, strongest bucket first.
+  // Bucket sort of candidate pixels by magnitude, strongest bucket first, stable in raster
+  // order. One pass over the image collects candidates and their bins, the second only the
+  // candidates. Hot loops use local pointers: stores to the uint8_t state may alias anything,
+  // which would make the compiler reload every vector's data pointer.
   const float bin_scale = (kBins - 1) / max_magnitude;
-  std::fill(bucket_start_.begin(), bucket_start_.end(), 0);
+  int* bucket_start = bucket_start_.data();
+  std::fill_n(bucket_start, kBins + 1, 0);
   const int n = w * h;
+  const float* magnitude = magnitude_.data();
+  const float* dir_x = dir_x_.data();
+  const float* dir_y = dir_y_.data();
+  uint8_t* state = state_.data();
+  int* candidate = candidate_.data();
+  uint16_t* candidate_bin = candidate_bin_.data();
+  int candidates = 0;
   for (int i = 0; i < n; ++i) {
-    if (state_[i] == kFree) ++bucket_start_[kBins - 1 - static_cast<int>(magnitude_[i] * bin_scale) + 1];
+    if (state[i] != kFree) continue;
+    const int bin = kBins - 1 - static_cast<int>(magnitude[i] * bin_scale);
+    candidate[candidates] = i;
+    candidate_bin[candidates++] = static_cast<uint16_t>(bin);
+    ++bucket_start[bin + 1];
   }
-  for (int b = 0; b < kBins; ++b) bucket_start_[b + 1] += bucket_start_[b];
-  const int candidates = bucket_start_[kBins];
-  for (int i = 0; i < n; ++i) {
-    if (state_[i] == kFree) ordered_[bucket_start_[kBins - 1 - static_cast<int>(magnitude_[i] * bin_scale)]++] = i;
-  }
+  for (int b = 0; b < kBins; ++b) bucket_start[b + 1] += bucket_start[b];
+  int* ordered = ordered_.data();
+  for (int k = 0; k < candidates; ++k) ordered[bucket_start[candidate_bin[k]]++] = candidate[k];
 
+  int* region = region_.data();
+  int16_t* region_x = region_x_.data();
+  int16_t* region_y = region_y_.data();
   int count = 0;
   for (int k = 0; k < candidates && count < capacity; ++k) {
-    const int seed = ordered_[k];
-    if (state_[seed] != kFree) continue;
+    const int seed = ordered[k];
+    if (state[seed] != kFree) continue;
     // Grow the region; its direction is the running (unnormalised) sum of unit gradients, whose
-    // norm only changes when a pixel joins.
-    state_[seed] = kUsed;
-    region_[0] = seed;
-    region_x_[0] = static_cast<int16_t>(seed % w);
-    region_y_[0] = static_cast<int16_t>(seed / w);
+    // norm (and so the alignment bound) only changes when a pixel joins.
+    state[seed] = kUsed;
+    region[0] = seed;
+    region_x[0] = static_cast<int16_t>(seed % w);
+    region_y[0] = static_cast<int16_t>(seed / w);
     int size = 1;
-    float sum_x = dir_x_[seed], sum_y = dir_y_[seed];
-    float norm = std::sqrt(sum_x * sum_x + sum_y * sum_y);
+    float sum_x = dir_x[seed], sum_y = dir_y[seed];
+    float bound = cos_tau * std::sqrt(sum_x * sum_x + sum_y * sum_y);
     for (int r = 0; r < size; ++r) {
-      const int px = region_x_[r], py = region_y_[r];
+      const int px = region_x[r], py = region_y[r];
       for (int dy = -1; dy <= 1; ++dy) {
         const int qy = py + dy;
         if (qy < 0 || qy >= h) continue;
@@ -128,16 +146,16 @@ int LineSegmentDetector::detect(const cv::Mat& image, float min_length, Detected
           const int qx = px + dx;
           if (qx < 0 || qx >= w) continue;
           const int q = qy * w + qx;
-          if (state_[q] != kFree) continue;
-          if (dir_x_[q] * sum_x + dir_y_[q] * sum_y < cos_tau * norm) continue;
-          state_[q] = kUsed;
-          region_[size] = q;
-          region_x_[size] = static_cast<int16_t>(qx);
-          region_y_[size] = static_cast<int16_t>(qy);
+          if (state[q] != kFree) continue;
+          if (dir_x[q] * sum_x + dir_y[q] * sum_y < bound) continue;
+          state[q] = kUsed;
+          region[size] = q;
+          region_x[size] = static_cast<int16_t>(qx);
+          region_y[size] = static_cast<int16_t>(qy);
           ++size;
-          sum_x += dir_x_[q];
-          sum_y += dir_y_[q];
-          norm = std::sqrt(sum_x * sum_x + sum_y * sum_y);
+          sum_x += dir_x[q];
+          sum_y += dir_y[q];
+          bound = cos_tau * std::sqrt(sum_x * sum_x + sum_y * sum_y);
         }
       }
     }

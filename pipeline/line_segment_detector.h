@@ -55,6 +55,8 @@ class LineSegmentDetector {
   std::vector<float> magnitude_, dir_x_, dir_y_;  // per pixel; unit gradient direction
   std::vector<uint8_t> state_;                    // 0 free, 1 used or below threshold
   std::vector<int> bucket_start_, ordered_;       // bucket sort of candidate pixels
+  std::vector<int> candidate_;                    // candidates in raster order ...
+  std::vector<uint16_t> candidate_bin_;           // ... and their magnitude bins
   std::vector<int> region_;                       // pixel indices of the growing region
   std::vector<int16_t> region_x_, region_y_;      // ... and their coordinates (no divisions)
 };
