@@ -1,10 +1,17 @@
 #include "drivers/dataset/tum_dataset.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
+#include "drivers/dataset/png_decoder.h"
 #include "drivers/dataset/tum_lists.h"
 
 namespace plumb {
@@ -12,15 +19,26 @@ namespace {
 
 bool fileExists(const std::string& path) { return std::ifstream(path).good(); }
 
-std::string typeName(const cv::Mat& m) {
-  const int depth = m.depth();
+std::string typeName(int type) {
+  const int depth = CV_MAT_DEPTH(type);
   const char* depth_name = depth == CV_8U    ? "8-bit"
                            : depth == CV_16U ? "16-bit"
                            : depth == CV_8S  ? "8-bit signed"
                            : depth == CV_16S ? "16-bit signed"
                            : depth == CV_32F ? "32-bit float"
                                              : "other-depth";
-  return std::string(depth_name) + " " + std::to_string(m.channels()) + "-channel";
+  return std::string(depth_name) + " " + std::to_string(CV_MAT_CN(type)) + "-channel";
+}
+
+// The checks every image passes whichever decoder read it; "" when it fits.
+std::string imageProblem(int type, int width, int height, bool is_depth, const PinholeCamera& camera) {
+  const int expected_type = is_depth ? CV_16UC1 : CV_8UC3;
+  if (type != expected_type)
+    return typeName(type) + " image, expected " + (is_depth ? "16-bit 1-channel depth" : "8-bit 3-channel colour");
+  if (width != camera.width || height != camera.height)
+    return "size " + std::to_string(width) + "x" + std::to_string(height) + ", camera expects " +
+           std::to_string(camera.width) + "x" + std::to_string(camera.height);
+  return "";
 }
 
 int64_t monotonicNowNs() {
@@ -29,22 +47,38 @@ int64_t monotonicNowNs() {
       .count();
 }
 
-// Reads the whole file into `bytes`, reusing its capacity from frame to frame.
-Status readFileBytes(const std::string& path, std::vector<unsigned char>* bytes) {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (!file) return Status::Error(path + ": missing or unreadable image file");
-  bytes->clear();
-  unsigned char chunk[65536];
-  std::size_t n = 0;
-  while ((n = std::fread(chunk, 1, sizeof(chunk), file)) > 0) bytes->insert(bytes->end(), chunk, chunk + n);
-  const bool failed = std::ferror(file) != 0;
-  std::fclose(file);
+// Reads the whole file into `bytes` (grown only when a file is larger than any before: no
+// allocation per frame; POSIX read, because stdio's FILE allocates its buffer on every fopen).
+Status readFileBytes(const std::string& path, std::vector<unsigned char>* bytes, std::size_t* size) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return Status::Error(path + ": missing or unreadable image file");
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) {
+    ::close(fd);
+    return Status::Error(path + ": read error");
+  }
+  const auto expected = static_cast<std::size_t>(st.st_size);
+  if (bytes->size() < expected) bytes->resize(expected);
+  std::size_t got = 0;
+  bool failed = false;
+  while (got < expected) {
+    const ssize_t n = ::read(fd, bytes->data() + got, expected - got);
+    if (n < 0 && errno == EINTR) continue;
+    failed = n < 0;
+    if (n <= 0) break;  // error, or the file shrank meanwhile (a truncated image: the decoder says so)
+    got += static_cast<std::size_t>(n);
+  }
+  ::close(fd);
   if (failed) return Status::Error(path + ": read error");
-  if (bytes->empty()) return Status::Error(path + ": empty image file");
+  if (got == 0) return Status::Error(path + ": empty image file");
+  *size = got;
   return Status::Ok();
 }
 
 }  // namespace
+
+TumDatasetSource::TumDatasetSource() = default;
+TumDatasetSource::~TumDatasetSource() = default;
 
 Status TumDatasetSource::open(const std::string& dir, const PinholeCamera& camera,
                               std::unique_ptr<TumDatasetSource>* out) {
@@ -75,30 +109,40 @@ Status TumDatasetSource::open(const std::string& dir, const PinholeCamera& camer
       if (!fileExists(dir + "/" + *relative))
         return Status::Error(dir + "/" + *relative + ": missing image file (listed in " + lists + ")");
     }
+    // Full paths once, so loading a frame builds no strings.
+    source->rgb_files_.push_back(dir + "/" + frame.rgb_path);
+    source->depth_files_.push_back(dir + "/" + frame.depth_path);
   }
+  source->png_ = std::make_unique<PngDecoder>();
   *out = std::move(source);
   return Status::Ok();
 }
 
-Status TumDatasetSource::loadImage(const std::string& relative_path, bool is_depth, cv::Mat& dst) {
-  const std::string path = dir_ + "/" + relative_path;
-  PLUMB_RETURN_IF_ERROR(readFileBytes(path, &file_bytes_));
-  // IMREAD_UNCHANGED keeps the stored bit depth so an 8-bit depth map is caught, not converted.
-  // Decoding into `dst` reuses its buffer when size and type match (every frame after the first).
+Status TumDatasetSource::loadImage(const std::string& path, bool is_depth, cv::Mat& dst) {
+  std::size_t size = 0;
+  PLUMB_RETURN_IF_ERROR(readFileBytes(path, &file_bytes_, &size));
+  PngHeader header;
+  if (png_->readHeader(file_bytes_.data(), size, &header)) {
+    // PNG (every TUM and ICL-NUIM image): libpng straight into dst, checked before decoding.
+    const int type = CV_MAKETYPE(header.bit_depth == 16 ? CV_16U : CV_8U, header.channels);
+    const std::string problem = imageProblem(type, header.width, header.height, is_depth, camera_);
+    if (!problem.empty()) return Status::Error(path + ": " + problem);
+    if (!png_->decodePixels(dst)) return Status::Error(path + ": " + png_->error());
+    return Status::Ok();
+  }
+  if (size >= 8 && std::memcmp(file_bytes_.data(), "\x89PNG\r\n\x1a\n", 8) == 0) {
+    return Status::Error(path + ": " + png_->error());  // a PNG libpng rejected
+  }
+  // Another format (e.g. a JPEG colour stream): OpenCV, which allocates per image. IMREAD_UNCHANGED
+  // keeps the stored bit depth so an 8-bit depth map is caught, not converted.
   try {
-    cv::imdecode(file_bytes_, cv::IMREAD_UNCHANGED, &dst);
+    cv::imdecode(cv::Mat(1, static_cast<int>(size), CV_8UC1, file_bytes_.data()), cv::IMREAD_UNCHANGED, &dst);
   } catch (const cv::Exception& e) {
     return Status::Error(path + ": cannot decode image (" + e.what() + ")");
   }
   if (dst.empty()) return Status::Error(path + ": corrupt, truncated or not an image");
-  const int expected_type = is_depth ? CV_16UC1 : CV_8UC3;
-  if (dst.type() != expected_type)
-    return Status::Error(path + ": " + typeName(dst) + " image, expected " +
-                         (is_depth ? "16-bit 1-channel depth" : "8-bit 3-channel colour"));
-  if (dst.cols != camera_.width || dst.rows != camera_.height)
-    return Status::Error(path + ": size " + std::to_string(dst.cols) + "x" + std::to_string(dst.rows) +
-                         ", camera expects " + std::to_string(camera_.width) + "x" +
-                         std::to_string(camera_.height));
+  const std::string problem = imageProblem(dst.type(), dst.cols, dst.rows, is_depth, camera_);
+  if (!problem.empty()) return Status::Error(path + ": " + problem);
   return Status::Ok();
 }
 
@@ -107,8 +151,8 @@ Status TumDatasetSource::load(std::size_t i, RgbdImage& out) {
     return Status::Error(describe() + ": frame " + std::to_string(i) + " out of range (" +
                          std::to_string(frames_.size()) + " frames)");
   const TumFrameEntry& frame = frames_[i];
-  PLUMB_RETURN_IF_ERROR(loadImage(frame.rgb_path, false, out.bgr));
-  PLUMB_RETURN_IF_ERROR(loadImage(frame.depth_path, true, out.depth_raw));
+  PLUMB_RETURN_IF_ERROR(loadImage(rgb_files_[i], false, out.bgr));
+  PLUMB_RETURN_IF_ERROR(loadImage(depth_files_[i], true, out.depth_raw));
   out.sequence = i;
   out.timestamp_s = frame.rgb_timestamp_s;
   out.depth_timestamp_s = frame.depth_timestamp_s;

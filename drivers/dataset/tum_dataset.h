@@ -10,9 +10,10 @@
 // (corrupt or truncated PNG, wrong size or bit depth, a file gone since open) by next()/load().
 // Messages name the file and, for lists, the line.
 //
-// Buffers: PNGs are read into a reused byte buffer and decoded with cv::imdecode straight into the
-// caller's RgbdImage Mats. libpng decoding still allocates internally, so replay is not
-// allocation-free; live sources are the ones held to that contract.
+// Buffers: image files are read into a reused byte buffer (POSIX read) and PNGs decoded by libpng
+// straight into the caller's RgbdImage Mats (PngDecoder, its structures in a fixed arena), so a
+// replayed frame allocates nothing once the Mats have their size. Other formats fall back to
+// cv::imdecode (allocates per image).
 #include <cstddef>
 #include <memory>
 #include <string>
@@ -21,6 +22,8 @@
 #include "drivers/common/frame_source.h"
 
 namespace plumb {
+
+class PngDecoder;
 
 // One associated RGB-D pair; paths are relative to the dataset folder.
 struct TumFrameEntry {
@@ -32,6 +35,7 @@ struct TumFrameEntry {
 
 class TumDatasetSource : public FrameSource {
  public:
+  ~TumDatasetSource() override;
   // Reads the lists of `dir` and checks them; `camera` must already be valid and its size is the
   // size every image must have.
   static Status open(const std::string& dir, const PinholeCamera& camera,
@@ -54,8 +58,8 @@ class TumDatasetSource : public FrameSource {
   void rewind() { cursor_ = 0; }
 
  private:
-  TumDatasetSource() = default;
-  Status loadImage(const std::string& relative_path, bool is_depth, cv::Mat& dst);
+  TumDatasetSource();
+  Status loadImage(const std::string& path, bool is_depth, cv::Mat& dst);
 
   std::string dir_;
   PinholeCamera camera_;
@@ -63,7 +67,9 @@ class TumDatasetSource : public FrameSource {
   bool used_associations_file_ = false;
   std::size_t cursor_ = 0;
   Status last_error_;
-  std::vector<unsigned char> file_bytes_;  // reused read buffer for PNG files
+  std::vector<std::string> rgb_files_, depth_files_;  // full paths, per frame
+  std::vector<unsigned char> file_bytes_;  // reused read buffer for image files
+  std::unique_ptr<PngDecoder> png_;
 };
 
 }  // namespace plumb
