@@ -19,7 +19,10 @@ OrbExtractor::OrbExtractor(const PinholeCamera& camera, const ExtractorOptions& 
       fast_(camera.width, camera.height, kMaxCornersPerLevel),
       describer_(pyramid_.stride()) {
   ranked_.resize(kMaxCornersPerLevel);
+  by_rank_.resize(kMaxCornersPerLevel);
+  rank_start_.resize(kMaxCornersPerLevel + 1);
   cell_has_corner_.resize(static_cast<size_t>(camera.width / 8 + 1) * (camera.height / 8 + 1));
+  cell_start_.resize(cell_has_corner_.size() + 1);
   // Geometric share per level: n0 * (1/s)^i, summing to num_features (ORB-SLAM's split).
   const int levels = pyramid_.numLevels();
   const double inv = 1.0 / options.scale_factor;
@@ -72,34 +75,58 @@ void OrbExtractor::selectOnLevel(int level, int wanted, FrameFeatures& out) {
   }
   const int num = fast_.suppress();
 
+  // Round-robin over cells = order by (rank within its cell, strength), where strength is the
+  // score with a raster-order tie-break (a total order: the result is unique). Counting sorts by
+  // cell and then by rank, so only the small per-cell and per-rank groups need comparisons.
   const FastCorner* corners = fast_.corners();
+  const int num_cells = cols * rows;
+  int* cell_start = cell_start_.data();
+  std::fill_n(cell_start, num_cells + 1, 0);
   for (int i = 0; i < num; ++i) {
-    ranked_[i].corner = corners[i];
-    ranked_[i].cell = ((corners[i].y - border) / cell) * cols + (corners[i].x - border) / cell;
+    const int c = ((corners[i].y - border) / cell) * cols + (corners[i].x - border) / cell;
+    by_rank_[i].cell = c;
+    ++cell_start[c + 1];
   }
-  auto stronger = [](const FastCorner& a, const FastCorner& b) {
-    if (a.score != b.score) return a.score > b.score;
-    return a.y != b.y ? a.y < b.y : a.x < b.x;  // deterministic tie-break
+  for (int c = 0; c < num_cells; ++c) cell_start[c + 1] += cell_start[c];
+  for (int i = 0; i < num; ++i) {
+    RankedCorner& r = ranked_[cell_start[by_rank_[i].cell]++];
+    r.corner = corners[i];
+    r.cell = by_rank_[i].cell;
+  }
+  auto stronger = [](const RankedCorner& a, const RankedCorner& b) {
+    if (a.corner.score != b.corner.score) return a.corner.score > b.corner.score;
+    return a.corner.y != b.corner.y ? a.corner.y < b.corner.y : a.corner.x < b.corner.x;  // deterministic tie-break
   };
-  auto begin = ranked_.begin(), end = ranked_.begin() + num;
-  std::sort(begin, end, [&](const RankedCorner& a, const RankedCorner& b) {
-    return a.cell != b.cell ? a.cell < b.cell : stronger(a.corner, b.corner);
-  });
-  for (int i = 0, cell_first = 0; i < num; ++i) {
-    if (i == 0 || ranked_[i].cell != ranked_[i - 1].cell) cell_first = i;
-    ranked_[i].rank = i - cell_first;
+  int* rank_start = rank_start_.data();
+  int max_rank = 0;
+  for (int c = 0, first = 0; c < num_cells; ++c) {  // cell_start[c] is now the end of cell c
+    const int end = cell_start[c];
+    std::sort(ranked_.begin() + first, ranked_.begin() + end, stronger);
+    for (int i = first; i < end; ++i) ranked_[i].rank = i - first;
+    max_rank = std::max(max_rank, end - first);
+    first = end;
   }
+  std::fill_n(rank_start, max_rank + 1, 0);
+  for (int i = 0; i < num; ++i) ++rank_start[ranked_[i].rank + 1];
+  for (int r = 0; r < max_rank; ++r) rank_start[r + 1] += rank_start[r];
+  for (int i = 0; i < num; ++i) by_rank_[rank_start[ranked_[i].rank]++] = ranked_[i];
   const int take = std::min(wanted, num);
-  std::partial_sort(begin, begin + take, end, [&](const RankedCorner& a, const RankedCorner& b) {
-    return a.rank != b.rank ? a.rank < b.rank : stronger(a.corner, b.corner);
-  });
+  for (int r = 0, first = 0; first < take; ++r) {  // rank_start[r] is now the end of rank r
+    const int end = rank_start[r];
+    if (end <= take) {
+      std::sort(by_rank_.begin() + first, by_rank_.begin() + end, stronger);
+    } else {
+      std::partial_sort(by_rank_.begin() + first, by_rank_.begin() + take, by_rank_.begin() + end, stronger);
+    }
+    first = end;
+  }
 
   const float scale = pyramid_.scale(level);
   const uint8_t* level_origin = image.ptr<uint8_t>(0);
   const uint8_t* blurred_origin = pyramid_.blurred(level).ptr<uint8_t>(0);
   const int stride = pyramid_.stride();
   for (int i = 0; i < take; ++i) {
-    const FastCorner& c = ranked_[i].corner;
+    const FastCorner& c = by_rank_[i].corner;
     KeypointObservation* kp = out.keypoints.emplace_back();
     Descriptor256* descriptor = out.keypoint_descriptors.emplace_back();
     if (kp == nullptr || descriptor == nullptr) {  // capacity reached: keep the arrays parallel

@@ -46,7 +46,11 @@ class OrbExtractor {
   FastDetector fast_;
   OrbDescriber describer_;
   std::array<int, kPyramidLevels> features_per_level_{};
-  std::vector<RankedCorner> ranked_;  // capacity fixed in the constructor, never grows
+  // Sorting scratch, sized in the constructor, never grows: corners grouped by cell (ranked_),
+  // then by rank (by_rank_, which first holds each raw corner's cell), and the counting-sort
+  // bucket starts per cell and per rank.
+  std::vector<RankedCorner> ranked_, by_rank_;
+  std::vector<int> cell_start_, rank_start_;
   std::vector<char> cell_has_corner_;  // per spreading cell of the current level (sized for 8 px cells)
   double pyramid_ms_ = 0;
 };
