@@ -31,8 +31,11 @@ class OrbDescriber {
  private:
   int stride_;
   std::array<int, kPatchRadius + 1> disc_half_width_{};  // half row width of the disc at dy
-  // [bin][2*bit + {0,1}] byte offsets of the two samples of each test.
-  std::array<std::array<int, 512>, kAngleBins> offsets_{};
+  // [bin][bit]: byte offsets of the first and the second sample of each test.
+  std::array<std::array<int, 256>, kAngleBins> first_offsets_{}, second_offsets_{};
+  // Per |dy|, weights of the pixels p[-15 .. 16] of rows +-dy for the intensity centroid: dx (or
+  // dy) inside the disc, 0 outside (16-bit multiply-adds, see orientationDeg).
+  alignas(16) std::array<std::array<int16_t, 32>, kPatchRadius + 1> x_weight_{}, y_weight_{};
 };
 
 }  // namespace plumb
