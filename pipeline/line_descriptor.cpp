@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 
+#include <opencv2/core/hal/intrin.hpp>
+
 namespace plumb {
 namespace {
 
@@ -29,40 +31,34 @@ void computeLineDescriptor(const cv::Mat& image, const cv::Point2f& start, const
   const int x_max = image.cols - 2, y_max = image.rows - 2;
   const int stride = static_cast<int>(image.step[0]);
   const uint8_t* data = image.ptr<uint8_t>(0);
+  const cv::v_float32x4 x_proj(nx, -nx, ux, -ux), y_proj(ny, -ny, uy, -uy), v_zero = cv::v_setzero_f32();
 
   for (int r = 0; r < rows; ++r) {
     const float offset = static_cast<float>(r - half_rows);
     const float weight = std::exp(-0.5f * offset * offset / (sigma * sigma));
+    const cv::v_float32x4 v_weight = cv::v_setall_f32(weight);
     std::array<float, kStats>& stats = band[r / w];
     // Walk the row incrementally; +0.5 then truncation rounds (coordinates are >= 0 inside).
-    // The first and second half of the positions feed separate sums; each half accumulates in
-    // locals (kept in registers) that continue the band's running sums in the same order.
+    // The first and second half of the positions feed separate sums.
     const float step_x = dx / positions, step_y = dy / positions;
     float fx = start.x + 0.5f * step_x + offset * nx + 0.5f, fy = start.y + 0.5f * step_y + offset * ny + 0.5f;
     const int half_end[2] = {(positions + 1) / 2, positions};  // 2k >= positions: second half
     for (int part = 0, k = 0; part < 2; ++part) {
+      // Lanes (across+, across-, along+, along-): the sample's projections onto (n, -n, u, -u),
+      // clamped at 0, added to the band's running sums in the same order as a scalar loop would
+      // (negation is exact, and adding the +-0 of the other sign leaves a sum unchanged).
       float* s = stats.data() + 4 * part;
-      float across_pos = s[0], across_neg = s[1], along_pos = s[2], along_neg = s[3];
+      cv::v_float32x4 sums = cv::v_load(s);
       for (; k < half_end[part]; ++k, fx += step_x, fy += step_y) {
         if (fx < 1 || fy < 1) continue;
         const int x = static_cast<int>(fx), y = static_cast<int>(fy);
         if (x < 1 || y < 1 || x > x_max || y > y_max) continue;
         const uint8_t* p = data + y * stride + x;
-        const float gx = static_cast<float>(p[1] - p[-1]);
-        const float gy = static_cast<float>(p[stride] - p[-stride]);
-        const float g_across = weight * (gx * nx + gy * ny);
-        const float g_along = weight * (gx * ux + gy * uy);
-        // Branch-free (gradient signs are random, so branches mispredict): adding +0 to the
-        // other sum leaves it unchanged, so the sums are exactly those of the if/else form.
-        across_pos += std::max(g_across, 0.f);
-        across_neg -= std::min(g_across, 0.f);
-        along_pos += std::max(g_along, 0.f);
-        along_neg -= std::min(g_along, 0.f);
+        const cv::v_float32x4 gx = cv::v_setall_f32(static_cast<float>(p[1] - p[-1]));
+        const cv::v_float32x4 gy = cv::v_setall_f32(static_cast<float>(p[stride] - p[-stride]));
+        sums += cv::v_max((gx * x_proj + gy * y_proj) * v_weight, v_zero);
       }
-      s[0] = across_pos;
-      s[1] = across_neg;
-      s[2] = along_pos;
-      s[3] = along_neg;
+      cv::v_store(s, sums);
     }
   }
 
