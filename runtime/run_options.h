@@ -46,6 +46,12 @@ struct RunOptions {
   // Both fall back, with one warning, when not permitted.
   int realtime_priority = 0;
   bool pin_threads = false;
+  // Stages (bit s = processing stage s, 1..N) whose results are off the latency path (plumb: map)
+  // run at nice background_nice (threaded modes), so that under CPU contention the kernel gives the
+  // latency-path stages the core first; they still get the idle time. Lowering one's own priority
+  // needs no privilege. Ignored for a stage that also gets SCHED_FIFO.
+  uint32_t background_stages = 0;
+  int background_nice = 10;
   // mlockall before the run (falls back with one warning).
   bool lock_memory = false;
 };

@@ -42,6 +42,7 @@
 #include "runtime/slot_pool.h"
 #include "runtime/spsc_ring.h"
 #include "runtime/stage.h"
+#include "runtime/thread_nice.h"
 #include "runtime/trace_log.h"
 
 namespace plumb::runtime {

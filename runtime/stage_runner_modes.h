@@ -28,8 +28,10 @@ void StageRunner<T>::applySettings(int s, const char* name) {
   ThreadSettings settings;
   settings.name = name;
   if (options_.pin_threads) settings.cpu = s % availableCpuCount();
-  settings.realtime_priority = options_.realtime_priority;
+  const bool background = s >= 1 && s < 32 && (options_.background_stages >> s & 1u) != 0;
+  settings.realtime_priority = background ? 0 : options_.realtime_priority;
   (void)applyThreadSettings(settings);  // failures are warned about once and fall back
+  if (background) (void)setCurrentThreadNice(options_.background_nice);
 }
 
 template <typename T>

@@ -124,10 +124,14 @@ class CaptureStage final : public runtime::Source<OdometrySlot> {
   Status error_;
 };
 
-// Stage 0 for a TUM-layout replay: timestamps come from the frame list, so peeking and skipping
-// cost nothing and only frames that get a slot are decoded (straight into the slot). In real-time
-// mode a replay that decodes every frame ahead falls behind as soon as decoding is slower than the
-// frame rate; this one only decodes what it delivers.
+// Stage 0 for a TUM-layout replay: frames by index, timestamps from the frame list. The next frame
+// is decoded AHEAD, in peekNext(), i.e. before the runner paces to its due time, and read() only
+// swaps the finished image into the slot (cv::Mat headers; the buffers circulate). Decoding PNG
+// files is an artefact of the storage format: a live sensor delivers a decoded frame at its
+// timestamp, and so does this replay. The frame's sensor time stays its recorded due time, so
+// end-to-end latency is not flattered; the decode shows in no stage's span (it runs while the
+// capture thread would otherwise sleep until the due time). A frame the runner then skips (no
+// free slot, source late) was decoded for nothing.
 class TumReplayCapture final : public runtime::Source<OdometrySlot> {
  public:
   TumReplayCapture(TumDatasetSource& replay, long max_frames, InputEnded& input_ended, DropLog& drops)
@@ -140,17 +144,25 @@ class TumReplayCapture final : public runtime::Source<OdometrySlot> {
       input_ended_.store(true);
       return false;
     }
+    if (!staged_) {
+      staged_status_ = replay_.load(next_, staging_);  // an error travels down through read()
+      staged_ = true;
+    }
     *t_recorded_ns = std::llround(replay_.timestamp(next_) * 1e9);
     return true;
   }
   Status read(OdometrySlot& slot, const runtime::FrameStamps& stamps) override {
-    const Status status = replay_.load(next_++, slot.image);
-    slot.image.t_sensor_ns = stamps.t_sensor_ns;
+    staged_ = false;
+    ++next_;
     slot.dropped_before = dropped_since_read_;
     dropped_since_read_ = 0;
-    return status;
+    if (!staged_status_.ok()) return staged_status_;
+    std::swap(slot.image, staging_);
+    slot.image.t_sensor_ns = stamps.t_sensor_ns;
+    return Status::Ok();
   }
   void skip() override {
+    staged_ = false;
     dropped_since_read_ += drops_.log(next_, replay_.timestamp(next_));
     ++next_;
   }
@@ -162,6 +174,9 @@ class TumReplayCapture final : public runtime::Source<OdometrySlot> {
   DropLog& drops_;
   uint32_t dropped_since_read_ = 0;
   std::size_t next_ = 0;  // the replay's own cursor is not used: load() is random access
+  RgbdImage staging_;
+  bool staged_ = false;
+  Status staged_status_;
 };
 
 // Stage 1: its own FeatureExtractor (extractors are one per thread), same options as the system's.
@@ -322,6 +337,9 @@ Status runStaged(FrameSource& source, OdometrySystem& system, const StagedRunOpt
   run_options.pin_threads = options.pin_threads;
   run_options.lock_memory = options.lock_memory;
   run_options.clock = options.clock;
+  // Mapping is off the latency path (poses are known when tracking is done): under contention the
+  // kernel serves capture, extract and track first.
+  run_options.background_stages = 1u << 3;
   // End to end = sensor time to pose known (track done); the map stage refines later frames' map.
   run_options.end_to_end_stage = 2;
   runtime::StageRunner<OdometrySlot> runner(capture, {&extract, &track, &map}, run_options);
@@ -360,7 +378,7 @@ const char* stagedRunUsage() {
          "                       timestamps, a frame finding no free slot is dropped and counted)\n"
          "  --profile FILE       write a Chrome trace (Perfetto / chrome://tracing) and print\n"
          "                       p50/p90/p99/max per stage and end to end, drops, frames/s\n"
-         "  --slots N            frame slots in flight (default 4)\n"
+         "  --slots N            frame slots in flight (default 8)\n"
          "  --rt-priority P      SCHED_FIFO priority 1..99 for stage threads (falls back if refused)\n"
          "  --pin-threads        pin stage threads to CPUs\n"
          "  --mlock              lock process memory (falls back if refused)\n";

@@ -34,7 +34,9 @@ namespace plumb::tools {
 
 struct StagedRunOptions {
   runtime::RunMode mode = runtime::RunMode::kDeterministic;
-  std::size_t slot_count = 4;    // frames in flight (realtime: more slots = fewer drops, more latency)
+  // Frames in flight. 8: the front stages keep working through a long local BA in the map stage
+  // (~2 frame periods) instead of stalling on a full pool (fast: idle cores; realtime: drops).
+  std::size_t slot_count = 8;
   std::string profile_path;      // Chrome trace written here after the run ('' = none)
   bool print_profile = true;     // print the latency table when profile_path is set
   int realtime_priority = 0;     // SCHED_FIFO for stage threads (0 = normal); falls back with a warning

@@ -147,6 +147,8 @@ int main(int argc, char** argv) {
   tools::StagedRunResult fast_result;
   check(runMode(dir, frames, runtime::RunMode::kFast, trace("fast.json"), &fast, &fast_result));
   std::printf("\nfast:\n%s", runtime::formatRunReport(fast_result.report).c_str());
+  // Threaded modes track against the newest map snapshot the map stage has published, which may
+  // lack the keyframe being inserted: close to, not equal to, the single-threaded trajectory.
   std::printf("fast trajectory %s the single-threaded one\n",
               fast.tum == single.tum ? "byte-identical to" : "differs from");
   std::printf("allocations after frame 30: %llu over %llu frames (%.1f per frame)\n",
@@ -161,7 +163,7 @@ int main(int argc, char** argv) {
   check(runMode(dir, frames, runtime::RunMode::kRealtime, trace("realtime.json"), &realtime, &realtime_result));
   std::printf("\nrealtime:\n%s", runtime::formatRunReport(realtime_result.report).c_str());
   std::printf("realtime trajectory %s the single-threaded one\n",
-              realtime.tum == single.tum ? "byte-identical to" : "differs from (frames were skipped)");
+              realtime.tum == single.tum ? "byte-identical to" : "differs from");
 
   std::printf("\nsummary\n");
   std::printf("deterministic_identical %s\n", identical ? "yes" : "no");
