@@ -6,6 +6,7 @@
 // coefficient) is in the ideal pinhole image after undistortion, which is what matching by
 // projection and the solver use. 3D quantities are in the camera frame of this image, metres.
 #include <array>
+#include <cstddef>
 #include <cstdint>
 
 #include <Eigen/Core>
@@ -15,6 +16,16 @@
 #include "platform/fixed_vector.h"
 
 namespace plumb {
+
+// std::array of Eigen fixed-size types filled with `value`. `std::array<Eigen::Vector3f, N> a{}`
+// leaves the coefficients uninitialised (Eigen's default constructor does not zero), so a
+// LineObservation{} would copy garbage (and GCC warns -Wmaybe-uninitialized in emplace_back).
+template <typename T, std::size_t N>
+std::array<T, N> filledArray(const T& value) {
+  std::array<T, N> a;
+  a.fill(value);
+  return a;
+}
 
 // 256-bit binary descriptor: ORB's rotated BRIEF, or a 256-bit LBD code.
 struct Descriptor256 {
@@ -54,9 +65,12 @@ struct LineObservation {
   // Line-guidance samples (paper section V-D): evenly spaced on the segment, back-projected with
   // depth, outliers to the robust 3D line fit removed. Only the first num_samples are valid.
   uint8_t num_samples = 0;
-  std::array<Eigen::Vector2f, kMaxLineSamples> sample_px{};     // undistorted sample pixels
-  std::array<Eigen::Vector3f, kMaxLineSamples> sample_P_cam{};  // 3D samples, camera frame
-  std::array<Eigen::Matrix3f, kMaxLineSamples> sample_cov{};    // their 3D covariances
+  std::array<Eigen::Vector2f, kMaxLineSamples> sample_px =  // undistorted sample pixels
+      filledArray<Eigen::Vector2f, kMaxLineSamples>(Eigen::Vector2f::Zero());
+  std::array<Eigen::Vector3f, kMaxLineSamples> sample_P_cam =  // 3D samples, camera frame
+      filledArray<Eigen::Vector3f, kMaxLineSamples>(Eigen::Vector3f::Zero());
+  std::array<Eigen::Matrix3f, kMaxLineSamples> sample_cov =  // their 3D covariances
+      filledArray<Eigen::Matrix3f, kMaxLineSamples>(Eigen::Matrix3f::Zero());
   // Robustly fitted 3D line (camera frame): a point on it and a unit direction; valid if has_3d.
   bool has_3d = false;
   Eigen::Vector3f line_point_cam = Eigen::Vector3f::Zero();
