@@ -1,11 +1,11 @@
 #pragma once
-// LatencyHistogram: fixed log-spaced bins from 10 us to 10 s (20 bins per decade, each bin ~12%
+// LatencyHistogram: fixed log-spaced bins from 10 us to 10 s (50 bins per decade, each bin ~4.7%
 // wide), plus an underflow and an overflow bin. add() is O(log bins) and never allocates, so
 // every stage thread can keep its own histogram on the hot path; merge them after the run.
 //
 // Percentiles use the nearest-rank definition (the smallest sample with at least p*n samples <= it)
 // and are reported as the upper edge of the bin holding that sample, capped at the exact maximum:
-// never below the true percentile, at most one bin width (~12%) above it.
+// never below the true percentile, at most one bin width (~4.7%) above it.
 #include <array>
 #include <cstdint>
 
@@ -15,7 +15,7 @@ class LatencyHistogram {
  public:
   static constexpr int64_t kMinNs = 10'000;  // 10 us: lower edge of the first real bin
   static constexpr int kDecades = 6;         // up to 10 s
-  static constexpr int kBinsPerDecade = 20;
+  static constexpr int kBinsPerDecade = 50;  // ~4.7 % per bin: a p99 against a 33 ms budget reads to ~1.5 ms
   static constexpr int kLogBins = kDecades * kBinsPerDecade;
   static constexpr int kBinCount = kLogBins + 2;  // [0] underflow, [kBinCount-1] overflow
 
