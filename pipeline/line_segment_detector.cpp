@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include <opencv2/core/hal/intrin.hpp>
 
@@ -10,6 +11,16 @@ namespace {
 
 constexpr int kBins = 1024;
 constexpr uint8_t kFree = 0, kUsed = 1;
+
+// Four bytes widened to int32 lanes. OpenCV 4.6's SSE v_load_expand_q reads them through an
+// int*, which is undefined behaviour (UBSan: misaligned load) when the address is not a multiple
+// of 4; the x + 1 loads below never are. Copying into an aligned buffer first is defined;
+// compilers fold the copy into the same single 32-bit load.
+inline cv::v_int32x4 loadExpand4(const uint8_t* p) {
+  alignas(4) uint8_t bytes[4];
+  std::memcpy(bytes, p, sizeof(bytes));
+  return cv::v_reinterpret_as_s32(cv::v_load_expand_q(bytes));
+}
 
 }  // namespace
 
@@ -60,10 +71,10 @@ int LineSegmentDetector::detect(const cv::Mat& image, float min_length, Detected
     const uint8_t* r1 = image.ptr<uint8_t>(y + 1);
     int x = 0;
     for (; x + 4 < w; x += 4) {  // reads x .. x + 4: stays inside the row
-      const cv::v_int32x4 a = cv::v_reinterpret_as_s32(cv::v_load_expand_q(r0 + x));
-      const cv::v_int32x4 b = cv::v_reinterpret_as_s32(cv::v_load_expand_q(r0 + x + 1));
-      const cv::v_int32x4 c = cv::v_reinterpret_as_s32(cv::v_load_expand_q(r1 + x));
-      const cv::v_int32x4 d = cv::v_reinterpret_as_s32(cv::v_load_expand_q(r1 + x + 1));
+      const cv::v_int32x4 a = loadExpand4(r0 + x);
+      const cv::v_int32x4 b = loadExpand4(r0 + x + 1);
+      const cv::v_int32x4 c = loadExpand4(r1 + x);
+      const cv::v_int32x4 d = loadExpand4(r1 + x + 1);
       const cv::v_float32x4 gx = v_half * cv::v_cvt_f32(b + d - a - c);
       const cv::v_float32x4 gy = v_half * cv::v_cvt_f32(c + d - a - b);
       const cv::v_float32x4 m = cv::v_sqrt(gx * gx + gy * gy);
