@@ -134,6 +134,18 @@ void OrbExtractor::selectOnLevel(int level, int wanted, FrameFeatures& out) {
       if (descriptor != nullptr) out.keypoint_descriptors.pop_back();
       break;
     }
+    if (i + 1 < take) {
+      // The patches of consecutive keypoints are far apart (ranked order) and the levels were
+      // written long ago: fetch the next keypoint's rows while this one is computed.
+      const FastCorner& next = by_rank_[i + 1].corner;
+      const int next_offset = next.y * stride + next.x;
+      for (int dy = -OrbDescriber::kPatchRadius; dy <= OrbDescriber::kPatchRadius; ++dy) {
+        __builtin_prefetch(level_origin + next_offset + dy * stride - OrbDescriber::kPatchRadius);
+        __builtin_prefetch(level_origin + next_offset + dy * stride + OrbDescriber::kPatchRadius);
+        __builtin_prefetch(blurred_origin + next_offset + dy * stride - OrbDescriber::kPatchRadius);
+        __builtin_prefetch(blurred_origin + next_offset + dy * stride + OrbDescriber::kPatchRadius);
+      }
+    }
     const int offset = c.y * stride + c.x;
     kp->angle_deg = describer_.orientationDeg(level_origin + offset);
     describer_.describe(blurred_origin + offset, kp->angle_deg, *descriptor);
