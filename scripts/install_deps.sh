@@ -4,7 +4,7 @@
 set -euo pipefail
 PACKAGES=(
   build-essential cmake pkg-config
-  libeigen3-dev libopencv-dev libopencv-contrib-dev libpng-dev
+  libeigen3-dev libopencv-dev libopencv-contrib-dev libpng-dev libdeflate-dev
   libopenni2-dev libv4l-dev libusb-1.0-0-dev
   libgtest-dev libbenchmark-dev
 )

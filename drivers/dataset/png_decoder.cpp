@@ -2,6 +2,8 @@
 
 #include <png.h>
 
+#include "drivers/dataset/png_fast_path.h"
+
 #include <csetjmp>
 #include <cstdio>
 #include <cstdlib>
@@ -62,7 +64,12 @@ struct PngCallbacks {
   }
 };
 
-PngDecoder::PngDecoder() : arena_(kArenaBytes) { rows_.reserve(1024); }
+PngDecoder::PngDecoder() : arena_(kArenaBytes) {
+  rows_.reserve(1024);
+#ifdef PLUMB_HAVE_LIBDEFLATE
+  fast_ = std::make_unique<PngFastPath>();
+#endif
+}
 
 PngDecoder::~PngDecoder() { destroy(); }
 
@@ -111,6 +118,9 @@ bool PngDecoder::readHeader(const uint8_t* bytes, std::size_t size, PngHeader* h
   png_uint_32 width = 0, height = 0;
   int bit_depth = 0, colour_type = 0, interlace = 0;
   png_get_IHDR(png, info, &width, &height, &bit_depth, &colour_type, &interlace, nullptr, nullptr);
+  stored_bit_depth_ = bit_depth;
+  colour_type_ = colour_type;
+  interlace_ = interlace;
   if (colour_type == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png);
   if (colour_type == PNG_COLOR_TYPE_GRAY && bit_depth < 8) png_set_expand_gray_1_2_4_to_8(png);
   if (bit_depth == 16 && kLittleEndianHost) png_set_swap(png);  // PNG stores 16-bit big-endian
@@ -133,6 +143,12 @@ bool PngDecoder::decodePixels(cv::Mat& dst) {
   auto png = static_cast<png_structp>(png_);
   auto info = static_cast<png_infop>(info_);
   dst.create(header_.height, header_.width, CV_MAKETYPE(header_.bit_depth == 16 ? CV_16U : CV_8U, header_.channels));
+#ifdef PLUMB_HAVE_LIBDEFLATE
+  if (fast_ && PngFastPath::handles(stored_bit_depth_, colour_type_, interlace_)) {
+    destroy();  // libpng has read the header; the fast path reads the whole file itself
+    return fast_->decode(bytes_, size_, stored_bit_depth_, colour_type_, dst, error_, sizeof(error_));
+  }
+#endif
   if (png_get_rowbytes(png, info) != dst.cols * dst.elemSize()) {
     std::snprintf(error_, sizeof(error_), "unexpected PNG row size");
     destroy();
