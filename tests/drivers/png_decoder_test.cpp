@@ -23,7 +23,7 @@ std::vector<uint8_t> encode(const cv::Mat& image) {
 // A PNG written with libpng directly: rows of `row_bytes` each, in PNG's own byte order.
 std::vector<uint8_t> writePng(int width, int height, int bit_depth, int colour_type, bool interlaced,
                               const std::vector<std::vector<uint8_t>>& rows,
-                              const std::vector<png_color>& palette = {}) {
+                              const std::vector<png_color>& palette = {}, int filters = PNG_ALL_FILTERS) {
   std::vector<uint8_t> out;
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   png_infop info = png_create_info_struct(png);
@@ -38,6 +38,7 @@ std::vector<uint8_t> writePng(int width, int height, int bit_depth, int colour_t
                interlaced ? PNG_INTERLACE_ADAM7 : PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
                PNG_FILTER_TYPE_DEFAULT);
   if (!palette.empty()) png_set_PLTE(png, info, palette.data(), int(palette.size()));
+  png_set_filter(png, PNG_FILTER_TYPE_BASE, filters);
   png_write_info(png, info);
   std::vector<png_bytep> pointers;
   for (const auto& row : rows) pointers.push_back(const_cast<png_bytep>(row.data()));
@@ -101,6 +102,34 @@ TEST(PngDecoder, InterlacedSixteenBitGrey) {
   cv::Mat out;
   ASSERT_TRUE(decode(decoder, writePng(w, h, 16, PNG_COLOR_TYPE_GRAY, true, rows), out)) << decoder.error();
   EXPECT_EQ(maxDifference(out, expected), 0.0);
+}
+
+// Each scanline filter alone (recordings mostly use Sub; encoders may pick any), for 3-byte and
+// 2-byte pixels, so every predictor of the decoder is compared against known pixels.
+TEST(PngDecoder, EveryFilterTypeDecodesExactly) {
+  const int w = 23, h = 11;
+  cv::Mat colour(h, w, CV_8UC3), depth(h, w, CV_16UC1);
+  cv::randu(colour, 0, 255);
+  cv::randu(depth, 0, 65535);
+  std::vector<std::vector<uint8_t>> colour_rows(h), depth_rows(h);
+  for (int r = 0; r < h; ++r) {
+    for (int c = 0; c < w; ++c) {
+      const cv::Vec3b bgr = colour.at<cv::Vec3b>(r, c);
+      colour_rows[r].insert(colour_rows[r].end(), {bgr[2], bgr[1], bgr[0]});  // PNG stores RGB
+      const uint16_t v = depth.at<uint16_t>(r, c);
+      depth_rows[r].insert(depth_rows[r].end(), {uint8_t(v >> 8), uint8_t(v & 0xff)});
+    }
+  }
+  PngDecoder decoder;
+  cv::Mat out;
+  for (int filter : {PNG_FILTER_NONE, PNG_FILTER_SUB, PNG_FILTER_UP, PNG_FILTER_AVG, PNG_FILTER_PAETH}) {
+    ASSERT_TRUE(decode(decoder, writePng(w, h, 8, PNG_COLOR_TYPE_RGB, false, colour_rows, {}, filter), out))
+        << decoder.error();
+    EXPECT_EQ(maxDifference(out, colour), 0.0) << "filter " << filter;
+    ASSERT_TRUE(decode(decoder, writePng(w, h, 16, PNG_COLOR_TYPE_GRAY, false, depth_rows, {}, filter), out))
+        << decoder.error();
+    EXPECT_EQ(maxDifference(out, depth), 0.0) << "filter " << filter;
+  }
 }
 
 TEST(PngDecoder, PaletteExpandsToBgr) {
