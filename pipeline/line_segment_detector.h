@@ -53,7 +53,7 @@ class LineSegmentDetector {
   int max_width_, max_height_;
   int width_ = 0, height_ = 0;
   std::vector<float> magnitude_, dir_x_, dir_y_;  // per pixel; unit gradient direction
-  std::vector<uint8_t> state_;                    // 0 free, 1 used or below threshold
+  std::vector<uint8_t> state_;                    // 1 free, 0 used or below threshold (padded, see .cpp)
   std::vector<int> bucket_start_, ordered_;       // bucket sort of candidate pixels
   std::vector<int> candidate_;                    // candidates in raster order ...
   std::vector<uint16_t> candidate_bin_;           // ... and their magnitude bins
