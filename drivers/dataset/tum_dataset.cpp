@@ -58,7 +58,9 @@ Status readFileBytes(const std::string& path, std::vector<unsigned char>* bytes,
     return Status::Error(path + ": read error");
   }
   const auto expected = static_cast<std::size_t>(st.st_size);
-  if (bytes->size() < expected) bytes->resize(expected);
+  // 50 % headroom: file sizes vary from frame to frame; growing to exactly the largest so far
+  // would reallocate whenever a later frame beats it.
+  if (bytes->size() < expected) bytes->resize(expected + expected / 2);
   std::size_t got = 0;
   bool failed = false;
   while (got < expected) {
