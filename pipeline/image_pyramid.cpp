@@ -1,6 +1,7 @@
 #include "pipeline/image_pyramid.h"
 
 #include <cmath>
+#include <cstring>
 #include <utility>
 
 #include <opencv2/core/hal/intrin.hpp>
@@ -19,12 +20,20 @@ ImagePyramid::ImagePyramid(int width, int height, int num_levels, float scale_fa
     total_rows += sizes[i].height;
   }
   row_filtered_.create(1, width + 6, CV_16UC1);  // one padded row
-  vertical_row_.create(1, width, CV_32SC1);
+  high_row_.create(1, width + 8, CV_16SC1);  // + padding: see downsample()
+  low_row_.create(1, width + 8, CV_16SC1);
+  high_row_.setTo(0);
+  low_row_.setTo(0);
   for (int i = 1; i < num_levels_; ++i) {
     x_tap_start_[i] = static_cast<int>(x_taps_.size());
     appendTaps(sizes[i - 1].width, sizes[i].width, x_taps_);
     y_tap_start_[i] = static_cast<int>(y_taps_.size());
     appendTaps(sizes[i - 1].height, sizes[i].height, y_taps_);
+  }
+  for (const Tap& t : x_taps_) {
+    // downsample() reads the pair (index0, index0 + 1): index1 may differ only with weight 0.
+    CV_Assert(t.index1 == t.index0 + 1 || t.weight == 0);
+    x_weight_pairs_.push_back(((1 << kWeightBits) - t.weight) | (t.weight << 16));
   }
   const cv::Mat kernel = cv::getGaussianKernel(7, 2.0, CV_64F);
   int sum = 0;
@@ -73,15 +82,26 @@ void ImagePyramid::downsample(int level) {
   const cv::Mat& src = levels_[level - 1];
   cv::Mat& dst = levels_[level];
   const Tap* x_taps = x_taps_.data() + x_tap_start_[level];
+  const int32_t* x_weights = x_weight_pairs_.data() + x_tap_start_[level];
   const Tap* y_taps = y_taps_.data() + y_tap_start_[level];
   const int one = 1 << kWeightBits;
   constexpr int kRound = 1 << (2 * kWeightBits - 1);
   // Each output pixel is the exact integer sum_ij p_ij * wy_i * wx_j (<= 255 * 2048^2, fits an
-  // int32), rounded once at the end, so the order of the two passes does not change a single
-  // value. Vertical first: it runs along contiguous source rows, 8 pixels per multiply-add of
-  // interleaved (row0, row1) 16-bit pairs against (wy0, wy1); the horizontal pass then gathers from
-  // one int32 row per output row.
-  int* vertical = vertical_row_.ptr<int>(0);
+  // int32), rounded once at the end, so the order of the passes and the split below do not
+  // change a single value.
+  // Vertical first: v = p0 * wy0 + p1 * wy1 (< 2^19) along contiguous source rows, 8 pixels per
+  // multiply-add of interleaved (row0, row1) 16-bit pairs against (wy0, wy1). v is kept as
+  // v = 1024 * high + low (high < 512, low < 1024) so the horizontal pass can also use 16-bit
+  // multiply-adds: v0 * wx0 + v1 * wx1 = 1024 * (high0 * wx0 + high1 * wx1) + (low0 * wx0 + low1 * wx1),
+  // where each (x0, x0 + 1) pair is one 32-bit read.
+  int16_t* high = high_row_.ptr<int16_t>(0);
+  int16_t* low = low_row_.ptr<int16_t>(0);
+  const cv::v_int32x4 low_mask = cv::v_setall_s32(1023), round = cv::v_setall_s32(kRound);
+  auto pairAt = [](const int16_t* row, int x) {  // (row[x], row[x + 1]) as one 32-bit lane
+    int32_t pair;
+    std::memcpy(&pair, row + x, sizeof(pair));
+    return pair;
+  };
   for (int y = 0; y < dst.rows; ++y) {
     const Tap& ty = y_taps[y];
     const uint8_t* s0 = src.ptr<uint8_t>(ty.index0);
@@ -94,16 +114,35 @@ void ImagePyramid::downsample(int level) {
       const cv::v_int16x8 b = cv::v_reinterpret_as_s16(cv::v_load_expand(s1 + x));
       cv::v_int16x8 lo, hi;
       cv::v_zip(a, b, lo, hi);  // (a0, b0, a1, b1, ...)
-      cv::v_store(vertical + x, cv::v_dotprod(lo, weights));
-      cv::v_store(vertical + x + 4, cv::v_dotprod(hi, weights));
+      const cv::v_int32x4 v_lo = cv::v_dotprod(lo, weights), v_hi = cv::v_dotprod(hi, weights);
+      cv::v_store(high + x, cv::v_pack(v_lo >> 10, v_hi >> 10));
+      cv::v_store(low + x, cv::v_pack(v_lo & low_mask, v_hi & low_mask));
     }
-    for (; x < src.cols; ++x) vertical[x] = s0[x] * w0 + s1[x] * w1;
-    // Horizontal: v0 * (2048 - w) + v1 * w written as v0 * 2048 + (v1 - v0) * w, one multiply;
-    // every term stays within +-255 * 2048^2.
+    for (; x < src.cols; ++x) {
+      const int v = s0[x] * w0 + s1[x] * w1;
+      high[x] = static_cast<int16_t>(v >> 10);
+      low[x] = static_cast<int16_t>(v & 1023);
+    }
+    // Horizontal. The clamped last tap reads the pair (x0, x0 + 1) with weights (2048, 0): the
+    // padding element past the row only ever meets a zero weight.
     uint8_t* d = dst.ptr<uint8_t>(y);
-    for (int xd = 0; xd < dst.cols; ++xd) {
+    int xd = 0;
+    for (; xd + 8 <= dst.cols; xd += 8) {
+      cv::v_int32x4 sums[2];
+      for (int g = 0; g < 2; ++g) {
+        const Tap* t = x_taps + xd + 4 * g;
+        const cv::v_int16x8 high_pairs = cv::v_reinterpret_as_s16(cv::v_int32x4(
+            pairAt(high, t[0].index0), pairAt(high, t[1].index0), pairAt(high, t[2].index0), pairAt(high, t[3].index0)));
+        const cv::v_int16x8 low_pairs = cv::v_reinterpret_as_s16(cv::v_int32x4(
+            pairAt(low, t[0].index0), pairAt(low, t[1].index0), pairAt(low, t[2].index0), pairAt(low, t[3].index0)));
+        const cv::v_int16x8 w = cv::v_reinterpret_as_s16(cv::v_load(x_weights + xd + 4 * g));
+        sums[g] = ((cv::v_dotprod(high_pairs, w) << 10) + cv::v_dotprod(low_pairs, w) + round) >> (2 * kWeightBits);
+      }
+      cv::v_pack_u_store(d + xd, cv::v_pack(sums[0], sums[1]));
+    }
+    for (; xd < dst.cols; ++xd) {
       const Tap& t = x_taps[xd];
-      const int v0 = vertical[t.index0], v1 = vertical[t.index1];
+      const int v0 = high[t.index0] * 1024 + low[t.index0], v1 = high[t.index1] * 1024 + low[t.index1];
       d[xd] = static_cast<uint8_t>((v0 * one + (v1 - v0) * t.weight + kRound) >> (2 * kWeightBits));
     }
   }

@@ -48,7 +48,8 @@ class ImagePyramid {
   static void appendTaps(int src_size, int dst_size, std::vector<Tap>& taps);
   std::vector<Tap> x_taps_, y_taps_;                          // all levels, concatenated
   std::array<int, kPyramidLevels> x_tap_start_{}, y_tap_start_{};  // each level's first entry
-  cv::Mat vertical_row_;            // CV_32SC1, one source row: the downsampler's vertical pass
+  std::vector<int32_t> x_weight_pairs_;  // per x tap: (2048 - weight) | weight << 16, two int16 lanes
+  cv::Mat high_row_, low_row_;      // CV_16SC1, one source row + padding: the vertical pass, split
 
   cv::Mat buffer_, blurred_buffer_;
   cv::Mat row_filtered_;            // CV_16UC1, one row + 3 px padding each side: the blur's vertical pass
