@@ -337,9 +337,14 @@ Status runStaged(FrameSource& source, OdometrySystem& system, const StagedRunOpt
   run_options.pin_threads = options.pin_threads;
   run_options.lock_memory = options.lock_memory;
   run_options.clock = options.clock;
-  // Mapping is off the latency path (poses are known when tracking is done): under contention the
-  // kernel serves capture, extract and track first.
-  run_options.background_stages = 1u << 3;
+  // Real time: mapping is off the latency path (poses are known when tracking is done), so under
+  // contention the kernel serves capture, extract and track first. Nice 5, not more: the map stage
+  // must still keep up on average, or the slots fill and frames drop. Not in fast mode, where
+  // every stage is on the throughput path.
+  if (options.mode == runtime::RunMode::kRealtime) {
+    run_options.background_stages = 1u << 3;
+    run_options.background_nice = 5;
+  }
   // End to end = sensor time to pose known (track done); the map stage refines later frames' map.
   run_options.end_to_end_stage = 2;
   runtime::StageRunner<OdometrySlot> runner(capture, {&extract, &track, &map}, run_options);
