@@ -6,6 +6,8 @@
 //      --repeat times (default 3), alternating, and the best run of each is compared: on a shared
 //      machine other jobs only ever slow a run down;
 //   4. --mode realtime at the recorded rate: p99 end-to-end latency (target <= 33 ms), drops (0).
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
@@ -30,6 +32,7 @@ struct Trajectory {
   std::string tum;  // the bytes a trajectory file would hold
   long frames = 0;
   double seconds = 0;
+  double cpu_seconds = 0;  // user + system time of the whole process (every thread) during the run
   double decode_ms = 0;    // single-threaded run: summed stage times (reading + decoding images)
   double extract_ms = 0;
   double odometry_ms = 0;  // track + map
@@ -48,6 +51,14 @@ void append(Trajectory* t, double timestamp_s, bool valid, const Eigen::Isometry
   t->poses.push_back(pose);
 }
 
+// Process CPU time (all threads): unlike wall time, other jobs on a shared machine do not inflate it.
+double processCpuSeconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + t.tv_usec * 1e-6; };
+  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
+}
+
 Status open(const std::string& dir, std::unique_ptr<FrameSource>* source) {
   return openFrameSource(dir, "", source);
 }
@@ -58,6 +69,7 @@ Status runSingleThreaded(const std::string& dir, long frames, Trajectory* out) {
   OdometrySystem system(source->camera(), SystemOptions{});
   auto on_frame = [&](const FinishedFrame& f) { append(out, f.timestamp_s, f.valid, f.T_world_cam); };
   RgbdImage image;
+  const double cpu_start = processCpuSeconds();
   const int64_t start = monotonicNowNs();
   while (out->frames < frames) {
     const int64_t t_read = monotonicNowNs();
@@ -73,6 +85,7 @@ Status runSingleThreaded(const std::string& dir, long frames, Trajectory* out) {
   }
   system.finish(on_frame, [](const RetiredKeyframe&) {});
   out->seconds = static_cast<double>(monotonicNowNs() - start) * 1e-9;
+  out->cpu_seconds = processCpuSeconds() - cpu_start;
   out->format();
   return Status::Ok();
 }
@@ -93,10 +106,12 @@ Status runMode(const std::string& dir, long frames, runtime::RunMode mode, const
     if (!output.dropped) ++out->frames;
     return Status::Ok();
   };
+  const double cpu_start = processCpuSeconds();
   const int64_t start = monotonicNowNs();
   PLUMB_RETURN_IF_ERROR(tools::runStaged(*source, system, options, on_output, result));
   system.finish(on_frame, [](const RetiredKeyframe&) {});
   out->seconds = static_cast<double>(monotonicNowNs() - start) * 1e-9;
+  out->cpu_seconds = processCpuSeconds() - cpu_start;
   out->format();
   return Status::Ok();
 }
@@ -191,6 +206,11 @@ int main(int argc, char** argv) {
   std::printf("deterministic_identical %s\n", identical ? "yes" : "no");
   std::printf("fast_over_single_threaded %.2f (best of %d: %.2f / %.2f frames/s)\n", best_fast_fps / best_single_fps,
               repeat, best_fast_fps, best_single_fps);
+  // Load-independent: CPU per frame of the threaded run over the single-threaded one (1.0 = the
+  // threads cost nothing extra; then two idle cores give min(2, ideal above) / this).
+  std::printf("cpu_per_frame_fast_over_single_threaded %.2f (%.2f / %.2f ms)\n",
+              (fast.cpu_seconds / fast.frames) / (single.cpu_seconds / single.frames),
+              1e3 * fast.cpu_seconds / fast.frames, 1e3 * single.cpu_seconds / single.frames);
   std::printf("realtime_p99_end_to_end_ms %.2f\n",
               static_cast<double>(realtime_result.report.end_to_end.percentileNs(0.99)) * 1e-6);
   std::printf("realtime_dropped_frames %llu (no free slot) + %llu (source late)\n",
