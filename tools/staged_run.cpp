@@ -313,7 +313,7 @@ class MapStage final : public runtime::Stage<OdometrySlot> {
 
 Status runStaged(FrameSource& source, OdometrySystem& system, const StagedRunOptions& options,
                  const FrameOutputFn& on_output, StagedRunResult* result) {
-  // A TUM replay is read by index (cheap peek/skip); any other source through next() + read-ahead.
+  // A TUM replay is read by index (timestamps from its list); any other source through next().
   InputEnded input_ended{false};
   DropLog drops;
   CaptureStage generic_capture(source, options.max_frames, input_ended, drops);

@@ -64,9 +64,9 @@ struct StagedRunResult {
 using FrameOutputFn = std::function<Status(const FrameOutput&)>;
 
 // Runs source -> extract -> track -> map until the source ends, max_frames, or an error. The system
-// must be fresh or continue a previous run; call system.finish() afterwards as usual. A TUM-layout
-// replay (TumDatasetSource) is played by index from its first frame, so dropped frames are never
-// decoded; other sources are read through next() one frame ahead.
+// must be fresh or continue a previous run; call system.finish() afterwards as usual. The next frame
+// is always read (decoded) ahead of its due time, as a sensor delivers finished frames: a
+// TUM-layout replay (TumDatasetSource) by index from its first frame, other sources through next().
 Status runStaged(FrameSource& source, OdometrySystem& system, const StagedRunOptions& options,
                  const FrameOutputFn& on_output, StagedRunResult* result);
 
