@@ -24,7 +24,7 @@ struct Simulated {
 };
 
 Simulated simulate(uint64_t frames, int64_t period_ns, std::size_t slots, int64_t mix_cost_ns,
-                   int64_t fold_cost_ns) {
+                   int64_t fold_cost_ns, int end_to_end_stage = 0) {
   VirtualClock clock;
   ToySource source(frames, period_ns);
   MixStage mix(&clock, mix_cost_ns);
@@ -33,6 +33,7 @@ Simulated simulate(uint64_t frames, int64_t period_ns, std::size_t slots, int64_
   options.mode = RunMode::kRealtime;
   options.slot_count = slots;
   options.clock = &clock;
+  options.end_to_end_stage = end_to_end_stage;
   StageRunner<ToyFrame> runner(source, {&mix, &fold}, options);
   Simulated result;
   const Status status = runner.run();
@@ -98,6 +99,18 @@ TEST(RealtimeSimulation, FastEnoughStagesDropNothingAndLatencyIsTheirCost) {
   EXPECT_EQ(r.report.frames_completed, 100u);
   EXPECT_EQ(r.report.end_to_end.maxNs(), 12 * kMs);
   EXPECT_EQ(r.report.end_to_end.percentileNs(0.99), 12 * kMs);
+}
+
+TEST(RealtimeSimulation, EndToEndCanEndAtAnEarlierStage) {
+  // As above, but end to end stops when "mix" is done (for plumb: the pose is known when tracking
+  // is done; mapping after it refines the map): 5 ms, the fold stage's 7 ms not included.
+  const Simulated r = simulate(100, 33 * kMs, 4, 5 * kMs, 7 * kMs, 1);
+  EXPECT_EQ(r.report.frames_completed, 100u);
+  EXPECT_EQ(r.report.end_to_end.maxNs(), 5 * kMs);
+  EXPECT_EQ(r.report.end_to_end_stage, 1);
+  EXPECT_NE(formatRunReport(r.report).find("sensor time to 'mix' done"), std::string::npos)
+      << formatRunReport(r.report);
+  EXPECT_EQ(simulate(5, 33 * kMs, 4, 5 * kMs, 7 * kMs).report.end_to_end_stage, 2);  // default: last
 }
 
 TEST(RealtimeSimulation, ASourceThatFallsBehindSkipsLateFramesInsteadOfLaggingForever) {
