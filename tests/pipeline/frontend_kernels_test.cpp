@@ -1,0 +1,206 @@
+// The vectorised front-end kernels against plain scalar oracles written from their definitions:
+// the pyramid (bilinear 1.2 steps, then the 7-tap fixed-point blur), the intensity-centroid
+// orientation and the LBD-style line descriptor. The fast versions claim to compute exactly the
+// same integers and floats, so the comparisons are for equality, not tolerance.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "pipeline/frame_features.h"
+#include "pipeline/image_pyramid.h"
+#include "pipeline/line_descriptor.h"
+#include "pipeline/orb_descriptor.h"
+
+namespace plumb {
+namespace {
+
+// A textured test image: smoothed noise plus a few strong edges, odd width so row tails
+// (widths not a multiple of 8 or 16) are exercised on every level.
+cv::Mat testImage(int width, int height, uint64_t seed) {
+  cv::Mat img(height, width, CV_8UC1);
+  cv::RNG rng(seed);
+  rng.fill(img, cv::RNG::UNIFORM, 0, 256);
+  cv::GaussianBlur(img, img, cv::Size(5, 5), 1.0);
+  cv::rectangle(img, cv::Rect(width / 5, height / 4, width / 3, height / 3), cv::Scalar(250), cv::FILLED);
+  cv::line(img, cv::Point(0, height - 1), cv::Point(width - 1, 0), cv::Scalar(5), 3);
+  return img;
+}
+
+// One axis of bilinear resampling with pixel centres at +0.5 (cv::resize's convention), in
+// 1/2048: source index and weight of index + 1.
+void bilinearTaps(int src_size, int dst_size, std::vector<int>* index, std::vector<int>* weight) {
+  const double step = static_cast<double>(src_size) / dst_size;
+  for (int d = 0; d < dst_size; ++d) {
+    const double f = (d + 0.5) * step - 0.5;
+    int i = static_cast<int>(std::floor(f));
+    double fraction = f - i;
+    if (i < 0) i = 0, fraction = 0;
+    if (i >= src_size - 1) i = src_size - 1, fraction = 0;
+    index->push_back(i);
+    weight->push_back(static_cast<int>(std::lround(fraction * 2048)));
+  }
+}
+
+// Exact bilinear: sum of the four products, rounded once.
+cv::Mat referenceDownsample(const cv::Mat& src, cv::Size size) {
+  std::vector<int> xi, xw, yi, yw;
+  bilinearTaps(src.cols, size.width, &xi, &xw);
+  bilinearTaps(src.rows, size.height, &yi, &yw);
+  cv::Mat dst(size, CV_8UC1);
+  for (int y = 0; y < size.height; ++y) {
+    const int y1 = std::min(yi[y] + 1, src.rows - 1);
+    for (int x = 0; x < size.width; ++x) {
+      const int x1 = std::min(xi[x] + 1, src.cols - 1);
+      const long sum = static_cast<long>(src.at<uint8_t>(yi[y], xi[x])) * (2048 - xw[x]) * (2048 - yw[y]) +
+                       static_cast<long>(src.at<uint8_t>(yi[y], x1)) * xw[x] * (2048 - yw[y]) +
+                       static_cast<long>(src.at<uint8_t>(y1, xi[x])) * (2048 - xw[x]) * yw[y] +
+                       static_cast<long>(src.at<uint8_t>(y1, x1)) * xw[x] * yw[y];
+      dst.at<uint8_t>(y, x) = static_cast<uint8_t>((sum + (1L << 21)) >> 22);
+    }
+  }
+  return dst;
+}
+
+// 7-tap Gaussian (sigma 2) in 8.8 fixed point, vertical then horizontal, each pass rounded,
+// reflected borders (BORDER_REFLECT_101).
+cv::Mat referenceBlur(const cv::Mat& src) {
+  const cv::Mat g = cv::getGaussianKernel(7, 2.0, CV_64F);
+  int k[7], sum = 0;
+  for (int i = 0; i < 7; ++i) sum += k[i] = static_cast<int>(std::lround(g.at<double>(i) * 256));
+  k[3] += 256 - sum;
+  auto reflect = [](int i, int n) { return i < 0 ? -i : (i >= n ? 2 * n - 2 - i : i); };
+  cv::Mat vertical(src.size(), CV_32SC1), dst(src.size(), CV_8UC1);
+  for (int y = 0; y < src.rows; ++y)
+    for (int x = 0; x < src.cols; ++x) {
+      int acc = 0;
+      for (int i = 0; i < 7; ++i) acc += k[i] * src.at<uint8_t>(reflect(y + i - 3, src.rows), x);
+      vertical.at<int>(y, x) = (acc + 128) >> 8;
+    }
+  for (int y = 0; y < src.rows; ++y)
+    for (int x = 0; x < src.cols; ++x) {
+      int acc = 0;
+      for (int i = 0; i < 7; ++i) acc += k[i] * vertical.at<int>(y, reflect(x + i - 3, src.cols));
+      dst.at<uint8_t>(y, x) = static_cast<uint8_t>((acc + 128) >> 8);
+    }
+  return dst;
+}
+
+TEST(FrontendKernels, PyramidEqualsExactBilinearAndFixedPointBlur) {
+  const cv::Mat img = testImage(643, 481, 11);
+  ImagePyramid pyramid(img.cols, img.rows, 8, 1.2f);
+  pyramid.build(img);
+  ASSERT_EQ(cv::norm(pyramid.level(0), img, cv::NORM_INF), 0);
+  for (int i = 0; i < pyramid.numLevels(); ++i) {
+    if (i > 0) {
+      const cv::Mat expected = referenceDownsample(pyramid.level(i - 1), pyramid.level(i).size());
+      EXPECT_EQ(cv::norm(pyramid.level(i), expected, cv::NORM_INF), 0) << "level " << i;
+    }
+    EXPECT_EQ(cv::norm(pyramid.blurred(i), referenceBlur(pyramid.level(i)), cv::NORM_INF), 0) << "blur, level " << i;
+  }
+  // The blur is not the identity and the levels really shrink (the test can fail).
+  EXPECT_GT(cv::norm(pyramid.blurred(0), pyramid.level(0), cv::NORM_INF), 20);
+  EXPECT_EQ(pyramid.level(7).cols, static_cast<int>(std::lround(643 / std::pow(1.2f, 7.f))));
+}
+
+TEST(FrontendKernels, OrientationEqualsIntensityCentroidOverTheDisc) {
+  const cv::Mat img = testImage(200, 150, 12);
+  const OrbDescriber describer(static_cast<int>(img.step[0]));
+  const int r = OrbDescriber::kPatchRadius;
+  int compared = 0;
+  std::array<int, 4> quadrants{};
+  for (int y = OrbDescriber::kBorder; y < img.rows - OrbDescriber::kBorder; y += 3) {
+    for (int x = OrbDescriber::kBorder; x < img.cols - OrbDescriber::kBorder; x += 5) {
+      int m10 = 0, m01 = 0;
+      for (int dy = -r; dy <= r; ++dy) {
+        const int w = static_cast<int>(std::floor(std::sqrt(double(r * r - dy * dy)) + 0.5));
+        for (int dx = -w; dx <= w; ++dx) {
+          m10 += dx * img.at<uint8_t>(y + dy, x + dx);
+          m01 += dy * img.at<uint8_t>(y + dy, x + dx);
+        }
+      }
+      const float expected = cv::fastAtan2(static_cast<float>(m01), static_cast<float>(m10));
+      ASSERT_EQ(describer.orientationDeg(img.ptr<uint8_t>(y) + x), expected) << "at " << x << "," << y;
+      ++quadrants[std::min(3, static_cast<int>(expected / 90))];
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 500);
+  for (int q : quadrants) EXPECT_GT(q, 10);  // every direction occurs
+}
+
+// The descriptor's definition, one sample at a time with plain if/else accumulation.
+Descriptor256 referenceLineDescriptor(const cv::Mat& image, cv::Point2f start, cv::Point2f end,
+                                      const LineDescriptorOptions& options) {
+  constexpr int kBands = 9, kStats = 8;
+  float band[kBands][kStats] = {};
+  Descriptor256 out;
+  const float dx = end.x - start.x, dy = end.y - start.y;
+  const float length = std::sqrt(dx * dx + dy * dy);
+  const float ux = dx / length, uy = dy / length, nx = -uy, ny = ux;
+  const int w = options.band_width, rows = kBands * w, half_rows = rows / 2;
+  const int positions = std::clamp(static_cast<int>(length), 4, std::max(4, options.max_positions));
+  const float sigma = 0.5f * rows;
+  for (int r = 0; r < rows; ++r) {
+    const float offset = static_cast<float>(r - half_rows);
+    const float weight = std::exp(-0.5f * offset * offset / (sigma * sigma));
+    const float step_x = dx / positions, step_y = dy / positions;
+    float fx = start.x + 0.5f * step_x + offset * nx + 0.5f, fy = start.y + 0.5f * step_y + offset * ny + 0.5f;
+    for (int k = 0; k < positions; ++k, fx += step_x, fy += step_y) {
+      if (fx < 1 || fy < 1) continue;
+      const int x = static_cast<int>(fx), y = static_cast<int>(fy);
+      if (x < 1 || y < 1 || x > image.cols - 2 || y > image.rows - 2) continue;
+      const float gx = static_cast<float>(image.at<uint8_t>(y, x + 1) - image.at<uint8_t>(y, x - 1));
+      const float gy = static_cast<float>(image.at<uint8_t>(y + 1, x) - image.at<uint8_t>(y - 1, x));
+      const float across = weight * (gx * nx + gy * ny), along = weight * (gx * ux + gy * uy);
+      float* s = band[r / w] + (2 * k >= positions ? 4 : 0);
+      if (across > 0) s[0] += across; else s[1] -= across;
+      if (along > 0) s[2] += along; else s[3] -= along;
+    }
+  }
+  int bit = 0;
+  auto put = [&](bool value) {
+    if (value) out.words[bit >> 6] |= 1ULL << (bit & 63);
+    ++bit;
+  };
+  for (int i = 0; i < kBands; ++i)
+    for (int j = i + 1; j < kBands && j - i <= 4; ++j)
+      for (int s = 0; s < kStats; ++s) put(band[i][s] > band[j][s]);
+  for (int i = 0; i < kBands - 1; ++i) {
+    const float* b = band[i];
+    put(b[0] > b[1]);
+    put(b[4] > b[5]);
+    put(b[2] > b[3]);
+    put(b[6] > b[7]);
+    put(b[0] > b[4]);
+    put(b[1] > b[5]);
+  }
+  return out;
+}
+
+TEST(FrontendKernels, LineDescriptorEqualsItsScalarDefinition) {
+  const cv::Mat img = testImage(320, 240, 13);
+  const LineDescriptorOptions options;
+  cv::RNG rng(14);
+  int distinct = 0;
+  Descriptor256 previous;
+  for (int i = 0; i < 300; ++i) {
+    // Segments of every direction and length, some reaching past the image border.
+    const cv::Point2f start(rng.uniform(-10.f, 330.f), rng.uniform(-10.f, 250.f));
+    const float angle = rng.uniform(0.f, static_cast<float>(2 * M_PI)), length = rng.uniform(5.f, 120.f);
+    const cv::Point2f end(start.x + length * std::cos(angle), start.y + length * std::sin(angle));
+    Descriptor256 fast;
+    computeLineDescriptor(img, start, end, options, fast);
+    const Descriptor256 expected = referenceLineDescriptor(img, start, end, options);
+    ASSERT_EQ(fast.words, expected.words) << "segment " << i;
+    distinct += hammingDistance(fast, previous) > 0;
+    previous = fast;
+  }
+  EXPECT_GT(distinct, 250);  // the descriptors depend on the segment
+}
+
+}  // namespace
+}  // namespace plumb
