@@ -71,20 +71,27 @@ struct StockPath {
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors, line_descriptors, grey;
   std::vector<cv::line_descriptor::KeyLine> keylines;
-  double orb_ms = 0, lsd_ms = 0, lbd_ms = 0;
+  double orb_ms = 0, lsd_ms = 0, lbd_ms = 0;              // wall
+  double orb_cpu_ms = 0, lsd_cpu_ms = 0, lbd_cpu_ms = 0;  // thread CPU time
 
   void run(const cv::Mat& bgr) {
     cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
     auto t = Clock::now();
+    double cpu = threadCpuMs();
     orb->detectAndCompute(grey, cv::noArray(), keypoints, descriptors);
     orb_ms = msSince(t);
+    orb_cpu_ms = threadCpuMs() - cpu;
     t = Clock::now();
+    cpu = threadCpuMs();
     keylines.clear();
     lsd->detect(grey, keylines, 2, 1);
     lsd_ms = msSince(t);
+    lsd_cpu_ms = threadCpuMs() - cpu;
     t = Clock::now();
+    cpu = threadCpuMs();
     lbd->compute(grey, keylines, line_descriptors);
     lbd_ms = msSince(t);
+    lbd_cpu_ms = threadCpuMs() - cpu;
   }
 };
 
@@ -161,6 +168,8 @@ int benchFrontend(int argc, char** argv) {
   Series cpu_total{"frontend total (CPU)", {}}, s_cpu_total{"stock total (CPU)", {}};
   Series s_orb{"stock cv::ORB", {}}, s_lsd{"stock LSDDetector", {}}, s_lbd{"stock BinaryDescriptor", {}},
       s_total{"stock total", {}};
+  Series s_cpu_orb{"stock cv::ORB (CPU)", {}}, s_cpu_lsd{"stock LSDDetector (CPU)", {}},
+      s_cpu_lbd{"stock BinaryDesc. (CPU)", {}};
   double sum_kp = 0, sum_kp_depth = 0, sum_lines = 0, sum_lines3d = 0, sum_stock_lines = 0;
   RgbdImage frame;
   const size_t n = max_frames > 0 ? std::min<size_t>(source->size(), max_frames) : source->size();
@@ -209,6 +218,9 @@ int benchFrontend(int argc, char** argv) {
       s_orb.ms.push_back(stock.orb_ms);
       s_lsd.ms.push_back(stock.lsd_ms);
       s_lbd.ms.push_back(stock.lbd_ms);
+      s_cpu_orb.ms.push_back(stock.orb_cpu_ms);
+      s_cpu_lsd.ms.push_back(stock.lsd_cpu_ms);
+      s_cpu_lbd.ms.push_back(stock.lbd_cpu_ms);
       sum_stock_lines += stock.keylines.size();
     }
   }
@@ -231,6 +243,9 @@ int benchFrontend(int argc, char** argv) {
     s_lsd.print();
     s_lbd.print();
     s_total.print();
+    s_cpu_orb.print();
+    s_cpu_lsd.print();
+    s_cpu_lbd.print();
     s_cpu_total.print();
     std::printf("  speed-up (stock / frontend, medians): wall %.1fx, CPU %.1fx\n",
                 s_total.percentile(0.5) / total.percentile(0.5), s_cpu_total.percentile(0.5) / cpu_total.percentile(0.5));
