@@ -2,7 +2,8 @@
 // FAST-9 corner detection (16-pixel Bresenham circle of radius 3, an arc of 9 contiguous pixels
 // all brighter or all darker than the centre by more than the threshold) with 3x3 non-maximum
 // suppression. Written here (rather than cv::FAST) so it writes into fixed buffers and allocates
-// nothing; the per-pixel rejection test is vectorised with OpenCV's universal intrinsics.
+// nothing; rejection tests and scores run on 16 pixels at a time with OpenCV's universal
+// intrinsics (SSE2, the x86-64 baseline; NEON on ARM).
 #include <cstdint>
 #include <memory>
 
