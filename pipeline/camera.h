@@ -24,6 +24,9 @@ struct PinholeCamera {
   double depth_factor = 5000.0;
   // Virtual baseline in metres for u_r = u - fx*b/d (ORB-SLAM2's RGB-D convention: 0.08 m).
   double baseline_m = 0.08;
+  // Rolling shutter: seconds from the first to the last image row's exposure; 0 = global shutter.
+  // The tracker moves features to the middle row's time (pipeline/tracker_rolling_shutter.h).
+  double rolling_shutter_readout_s = 0.0;
 
   bool hasDistortion() const { return k1 != 0 || k2 != 0 || p1 != 0 || p2 != 0 || k3 != 0; }
 
@@ -77,6 +80,8 @@ struct PinholeCamera {
     if (width <= 0 || height <= 0) return "image size must be positive";
     if (!finite(depth_factor) || depth_factor <= 0) return "depth factor must be positive";
     if (!finite(baseline_m) || baseline_m <= 0) return "baseline must be positive";
+    if (!finite(rolling_shutter_readout_s) || rolling_shutter_readout_s < 0)
+      return "rolling_shutter_readout must be >= 0";
     return "";
   }
 };

@@ -34,6 +34,7 @@ std::map<std::string, CameraKey> cameraKeys(PinholeCamera* c) {
       {"height", {nullptr, &c->height, false, true}},
       {"depth_factor", {&c->depth_factor, nullptr, false, true}},
       {"baseline", {&c->baseline_m, nullptr, false, true}},
+      {"rolling_shutter_readout", {&c->rolling_shutter_readout_s, nullptr, false, false}},
   };
 }
 

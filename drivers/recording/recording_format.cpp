@@ -18,7 +18,7 @@ void encodeFileHeader(const PinholeCamera& camera, std::vector<uint8_t>& out) {
   w.u32(kRecordingVersion);
   w.u32(static_cast<uint32_t>(kFileHeaderSize));
   for (double v : {camera.fx, camera.fy, camera.cx, camera.cy, camera.k1, camera.k2, camera.p1,
-                   camera.p2, camera.k3, camera.depth_factor, camera.baseline_m}) {
+                   camera.p2, camera.k3, camera.depth_factor, camera.baseline_m, camera.rolling_shutter_readout_s}) {
     w.f64(v);
   }
   w.i32(camera.width);
@@ -44,7 +44,7 @@ Status decodeFileHeader(const uint8_t* bytes, std::size_t size, PinholeCamera* c
   const uint32_t expected_crc = crc32(bytes, kFileHeaderSize - 4);
   PinholeCamera c;
   for (double* v : {&c.fx, &c.fy, &c.cx, &c.cy, &c.k1, &c.k2, &c.p1, &c.p2, &c.k3,
-                    &c.depth_factor, &c.baseline_m}) {
+                    &c.depth_factor, &c.baseline_m, &c.rolling_shutter_readout_s}) {
     *v = r.f64();
   }
   c.width = r.i32();

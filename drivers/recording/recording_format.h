@@ -4,7 +4,7 @@
 //
 //   file   = FileHeader chunk*
 //   chunk  = ChunkHeader payload chunk_crc
-//   FileHeader (116 bytes): "PLUMBREC", version, header size, camera, header CRC
+//   FileHeader (124 bytes): "PLUMBREC", version, header size, camera, header CRC
 //   ChunkHeader (16 bytes): "PLCK", type, payload size, CRC of these 12 bytes
 //   chunk_crc (4 bytes): CRC-32 of ChunkHeader + payload
 //
@@ -21,8 +21,9 @@
 namespace plumb {
 
 constexpr char kRecordingMagic[8] = {'P', 'L', 'U', 'M', 'B', 'R', 'E', 'C'};
-constexpr uint32_t kRecordingVersion = 1;
-constexpr std::size_t kFileHeaderSize = 116;
+// Version 2 added the camera's rolling-shutter readout time (version 1 files are refused).
+constexpr uint32_t kRecordingVersion = 2;
+constexpr std::size_t kFileHeaderSize = 124;
 
 constexpr char kChunkMagic[4] = {'P', 'L', 'C', 'K'};
 constexpr std::size_t kChunkHeaderSize = 16;
