@@ -1,7 +1,12 @@
 #include "pipeline/tracker.h"
 
 
+#include <cmath>
+#include <limits>
+
 #include "pipeline/keyframe_policy.h"
+#include "pipeline/tracker_rolling_shutter.h"
+#include "solver/se3.h"
 
 namespace plumb {
 
@@ -44,6 +49,8 @@ Tracker::Tracker(const PinholeCamera& camera, const OdometryOptions& options)
 Tracker::~Tracker() = default;
 
 void Tracker::setLocalMap(const LocalMap& local_map) {
+  // Corrections only make sense within one map segment (a new segment restarts with resetAt).
+  const bool same_map = local_map_->version != 0 && local_map.segment == local_map_->segment;
   *local_map_ = local_map;
   b_->point_visible.fill(0);
   b_->point_found.fill(0);
@@ -53,6 +60,7 @@ void Tracker::setLocalMap(const LocalMap& local_map) {
   // name a landmark keep their 3D point but lose the (now possibly stale) local index.
   for (auto& a : b_->last_points) a.local_index = -1;
   for (auto& a : b_->last_lines) a.local_index = -1;
+  if (has_last_frame_ && same_map) followMapCorrections();
 }
 
 void Tracker::reset() {
@@ -66,13 +74,23 @@ void Tracker::reset() {
 void Tracker::resetAt(const FrameFeatures& frame, const Eigen::Isometry3d& T_world_cam) {
   clearAssociations(frame);
   rememberLastFrame(frame, T_world_cam);
+  last_sequence_ = kUnknownSequence;
+  last_timestamp_s_ = std::numeric_limits<double>::quiet_NaN();  // the next velocity has no time span
   has_velocity_ = false;
   state_ = TrackingState::kOk;
   frames_since_keyframe_ = 0;
 }
 
-TrackResult Tracker::track(const FrameFeatures& frame, uint64_t sequence, double timestamp_s,
+TrackResult Tracker::track(const FrameFeatures& input, uint64_t sequence, double timestamp_s,
                            KeyframeRequest* request) {
+  const FrameFeatures* features = &input;
+  if (camera_.rolling_shutter_readout_s > 0 && has_velocity_ && velocity_dt_s_ > 0) {
+    b_->compensated_frame = input;
+    compensateRollingShutter(camera_, camera_.rolling_shutter_readout_s,
+                             logSE3(velocity_cur_last_) / velocity_dt_s_, &b_->compensated_frame);
+    features = &b_->compensated_frame;
+  }
+  const FrameFeatures& frame = *features;
   TrackResult result;
   ++frame_stamp_;
   if (!has_last_frame_) {
@@ -141,6 +159,7 @@ TrackResult Tracker::track(const FrameFeatures& frame, uint64_t sequence, double
   }
 
   velocity_cur_last_ = T_cam_world * T_world_last_;
+  velocity_dt_s_ = timestamp_s - last_timestamp_s_;
   has_velocity_ = true;
   ++frames_since_keyframe_;
   if (request != nullptr && keyframeNeeded(frame, result)) {
@@ -149,6 +168,8 @@ TrackResult Tracker::track(const FrameFeatures& frame, uint64_t sequence, double
     frames_since_keyframe_ = 0;
   }
   rememberLastFrame(frame, T_world_cam);
+  last_sequence_ = sequence;
+  last_timestamp_s_ = timestamp_s;
   return result;
 }
 
@@ -177,6 +198,8 @@ void Tracker::rememberLastFrame(const FrameFeatures& frame, const Eigen::Isometr
   b_->last_frame = frame;
   T_world_last_ = T_world_cam;
   has_last_frame_ = true;
+  last_reference_id_ = local_map_->reference_keyframe_id;
+  T_world_last_reference_ = local_map_->T_world_reference;
   const Eigen::Matrix3d R = T_world_cam.linear();
   const Eigen::Vector3d t = T_world_cam.translation();
   for (std::size_t k = 0; k < frame.keypoints.size(); ++k) {

@@ -1,6 +1,10 @@
 #pragma once
 // Tracker: the pose of each frame from the local map (ORB-SLAM2's Tracking, without the map).
 //
+//   0. rolling-shutter cameras (PinholeCamera::rolling_shutter_readout_s > 0): every feature is
+//      moved to the time of the frame's middle row with the constant-velocity motion
+//      (pipeline/tracker_rolling_shutter.h); the tracker, the map and local BA then see a
+//      global-shutter frame;
 //   1. predict with constant velocity; match the last frame's features by projection (points with
 //      depth or a landmark, lines with their 3D samples); too few matches -> retry with a wide
 //      window, then with zero motion (fast rotations break the velocity guess);
@@ -38,7 +42,10 @@ class Tracker {
   Tracker(const Tracker&) = delete;
   Tracker& operator=(const Tracker&) = delete;
 
-  // Swaps in a new snapshot (copied; visibility counters restart).
+  // Swaps in a new snapshot (copied; visibility counters restart). Like ORB-SLAM2's
+  // UpdateLastFrame, the last frame follows what local BA did meanwhile: its pose moves with its
+  // reference keyframe (or becomes the keyframe's refined pose when it was made one), its depth
+  // points move with it, and its landmark associations take the landmarks' refined positions.
   void setLocalMap(const LocalMap& local_map);
   const LocalMap& localMap() const { return *local_map_; }
 
@@ -86,6 +93,8 @@ class Tracker {
                               TrackResult* result);
   // tracker.cpp
   void rememberLastFrame(const FrameFeatures& frame, const Eigen::Isometry3d& T_world_cam);
+  // tracker_last_frame.cpp: the setLocalMap update of the last frame described above.
+  void followMapCorrections();
   void fillKeyframeRequest(const FrameFeatures& frame, uint64_t sequence, double timestamp_s,
                            const Eigen::Isometry3d& T_world_cam, KeyframeRequest* request);
   bool keyframeNeeded(const FrameFeatures& frame, const TrackResult& result) const;
@@ -101,14 +110,24 @@ class Tracker {
   TrackingState state_ = TrackingState::kNotInitialized;
   bool has_last_frame_ = false;
   Eigen::Isometry3d T_world_last_ = Eigen::Isometry3d::Identity();
+  // The last frame's sequence and its reference keyframe as the snapshot it was tracked with gave
+  // it: the next snapshot's pose of that keyframe tells how far local BA moved the frame.
+  static constexpr uint64_t kUnknownSequence = ~uint64_t(0);
+  uint64_t last_sequence_ = kUnknownSequence;
+  uint32_t last_reference_id_ = 0;
+  Eigen::Isometry3d T_world_last_reference_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d velocity_cur_last_ = Eigen::Isometry3d::Identity();  // T_cam(k) <- T_cam(k-1)
   bool has_velocity_ = false;
+  // Rolling shutter: the velocity's time span (NaN when unknown) and the last frame's timestamp.
+  double velocity_dt_s_ = 0;
+  double last_timestamp_s_ = 0;
   int frames_since_keyframe_ = 0;
   uint64_t frame_stamp_ = 0;  // increments per track(): marks landmark slots matched this frame
 
   // Everything big lives in one block allocated at construction.
   struct Buffers {
     LocalMap local_map;
+    FrameFeatures compensated_frame;  // the input moved to its middle row's time (rolling shutter)
     FrameFeatures last_frame;
     std::array<PointAssociation, kMaxKeypoints> last_points;  // per last-frame keypoint
     std::array<LineAssociation, kMaxLines> last_lines;
