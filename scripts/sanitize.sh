@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# AddressSanitizer + UndefinedBehaviorSanitizer sweep: configure and build the `asan` preset
+# (build-asan/, Debug, -fsanitize=address,undefined) and run every test binary under it.
+#
+#   bash scripts/sanitize.sh                  # all areas
+#   bash scripts/sanitize.sh pipeline system  # only these areas
+#   JOBS=1 nice -n 19 bash scripts/sanitize.sh
+#
+# Each area's binary runs once as a whole (not one process per test through ctest) because
+# sanitizer start-up and Debug OpenCV/Eigen are slow. Leaks are reported (detect_leaks=1), and
+# the first UB report ends the binary (halt_on_error=1) so it cannot scroll by unnoticed.
+# Exit status: 0 only if every binary passed. Full logs: build-asan/sanitize-logs/<area>.log.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+
+JOBS=${JOBS:-$(nproc 2>/dev/null || echo 2)}
+ALL_AREAS=(platform runtime solver pipeline drivers devices tools system)
+if [ "$#" -gt 0 ]; then AREAS=("$@"); else AREAS=("${ALL_AREAS[@]}"); fi
+
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+
+start=$(date +%s)
+cmake --preset asan >/dev/null || exit 1
+# tools/system tests run the built `plumb` tool, so build it with them.
+targets=(plumb)
+for area in "${AREAS[@]}"; do targets+=("plumb_test_${area}"); done
+cmake --build build-asan -j "$JOBS" --target "${targets[@]}" || exit 1
+built=$(date +%s)
+
+logs=build-asan/sanitize-logs
+mkdir -p "$logs"
+failed=()
+for area in "${AREAS[@]}"; do
+  log="$logs/${area}.log"
+  echo "== ASan+UBSan: plumb_test_${area} =="
+  t0=$(date +%s)
+  # The working directory is the build dir, as for ctest (tests find ../shared by absolute path).
+  (cd build-asan && "./bin/plumb_test_${area}") >"$log" 2>&1
+  rc=$?
+  t1=$(date +%s)
+  # The gtest summary lines plus any sanitizer report headline.
+  grep -E '^\[  (PASSED|SKIPPED|FAILED) +\]|test suites? ran|ERROR: (Address|Leak)Sanitizer|runtime error:' \
+    "$log" | head -30
+  echo "   exit ${rc}, $((t1 - t0)) s, log ${log}"
+  [ "$rc" -eq 0 ] || failed+=("$area")
+done
+
+end=$(date +%s)
+echo "== build $((built - start)) s, tests $((end - built)) s, total $((end - start)) s =="
+if [ "${#failed[@]}" -gt 0 ]; then
+  echo "FAILED: ${failed[*]}"
+  exit 1
+fi
+echo "all ${#AREAS[@]} binaries passed under ASan+UBSan"
