@@ -19,6 +19,8 @@ if [ "$#" -gt 0 ]; then AREAS=("$@"); else AREAS=("${ALL_AREAS[@]}"); fi
 
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+# Known third-party leaks only (Debian's OpenNI2 drivers); the file says why each is there.
+export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/scripts/lsan_suppressions.txt:print_suppressions=0}
 
 start=$(date +%s)
 cmake --preset asan >/dev/null || exit 1
