@@ -98,6 +98,8 @@ Status writeCameraFile(const std::string& path, const PinholeCamera& camera) {
   for (const auto& r : reals) std::fprintf(file, "%s %.17g\n", r.key, r.value);
   std::fprintf(file, "width %d\nheight %d\n", camera.width, camera.height);
   std::fprintf(file, "depth_factor %.17g\nbaseline %.17g\n", camera.depth_factor, camera.baseline_m);
+  // Written even when 0 (global shutter) so a folder exported from a recording replays the same.
+  std::fprintf(file, "rolling_shutter_readout %.17g\n", camera.rolling_shutter_readout_s);
   const bool write_failed = std::ferror(file) != 0;
   if (std::fclose(file) != 0 || write_failed) return Status::Error(path + ": write failed");
   return Status::Ok();

@@ -112,6 +112,8 @@ TEST(CameraFile, WriteReadRoundTripIsExact) {
   EXPECT_EQ(back.width, 320);
   EXPECT_EQ(back.height, 240);
   EXPECT_EQ(back.baseline_m, 0.075);
+  EXPECT_EQ(back.rolling_shutter_readout_s, camera.rolling_shutter_readout_s);
+  EXPECT_GT(back.rolling_shutter_readout_s, 0.0);  // the Kinect preset has a rolling shutter
 }
 
 TEST(CameraFile, MinimalFileHasNoDistortionAndDefaults) {
