@@ -15,10 +15,13 @@ std::string formatNumber(const char* format, double value) {
   return text;
 }
 
-// `# <timestamp> lost` as written by formatTumLine for a frame without a pose.
-bool parseLostMarker(const TextLine& line, double* timestamp) {
-  return line.is_comment && line.tokens.size() == 2 && line.tokens[1] == "lost" &&
-         parseDouble(line.tokens[0], timestamp) && std::isfinite(*timestamp);
+// `# <timestamp> lost` or `# <timestamp> dropped` as written by formatTumLine for a frame without
+// a pose (tracking lost, or never processed because the real-time mode had no free slot).
+bool parseLostMarker(const TextLine& line, double* timestamp, bool* dropped) {
+  if (!line.is_comment || line.tokens.size() != 2) return false;
+  if (line.tokens[1] != "lost" && line.tokens[1] != "dropped") return false;
+  *dropped = line.tokens[1] == "dropped";
+  return parseDouble(line.tokens[0], timestamp) && std::isfinite(*timestamp);
 }
 
 Status parsePoseLine(const std::string& where, const TextLine& line, const TrajectoryReadOptions& options,
@@ -63,7 +66,7 @@ Status readTumTrajectory(const std::string& path, std::vector<StampedPose>* out,
     const std::string where = fileLine(path, line.number);
     StampedPose pose;
     if (line.is_comment) {
-      if (!parseLostMarker(line, &pose.timestamp) || !options.keep_lost_markers) continue;
+      if (!parseLostMarker(line, &pose.timestamp, &pose.dropped) || !options.keep_lost_markers) continue;
       pose.valid = false;
     } else {
       bool normalised = false;

@@ -28,10 +28,16 @@ TEST(TrajectoryIo, WriteReadRoundTripWithLostFrames) {
   lost.timestamp = 1305031453.391700;
   lost.valid = false;
   poses.insert(poses.begin() + 2, lost);
+  StampedPose dropped;  // a real-time drop: never processed
+  dropped.timestamp = 1305031453.423000;
+  dropped.valid = false;
+  dropped.dropped = true;
+  poses.insert(poses.begin() + 3, dropped);
   const std::string path = dir.file("traj.txt");
   ASSERT_TRUE(writeTumTrajectory(path, poses).ok());
   const std::string text = testing::readWholeFile(path);
   EXPECT_NE(text.find("\n# 1305031453.391700 lost\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("\n# 1305031453.423000 dropped\n"), std::string::npos) << text;
 
   std::vector<StampedPose> without_lost, with_lost;
   ASSERT_TRUE(readTumTrajectory(path, &without_lost).ok());
@@ -39,11 +45,15 @@ TEST(TrajectoryIo, WriteReadRoundTripWithLostFrames) {
   keep.keep_lost_markers = true;
   ASSERT_TRUE(readTumTrajectory(path, &with_lost, keep).ok());
   ASSERT_EQ(without_lost.size(), 3u);
-  ASSERT_EQ(with_lost.size(), 4u);
+  ASSERT_EQ(with_lost.size(), 5u);
   EXPECT_FALSE(with_lost[2].valid);
+  EXPECT_FALSE(with_lost[2].dropped);
   EXPECT_DOUBLE_EQ(with_lost[2].timestamp, lost.timestamp);
+  EXPECT_FALSE(with_lost[3].valid);
+  EXPECT_TRUE(with_lost[3].dropped);
+  EXPECT_DOUBLE_EQ(with_lost[3].timestamp, dropped.timestamp);
   for (std::size_t i = 0; i < 3; ++i) {
-    const StampedPose& expected = poses[i < 2 ? i : 3];
+    const StampedPose& expected = poses[i < 2 ? i : 4];
     EXPECT_NEAR(without_lost[i].timestamp, expected.timestamp, 1e-6);
     EXPECT_TRUE(without_lost[i].T_world_cam.isApprox(expected.T_world_cam, 1e-8)) << i;
   }
