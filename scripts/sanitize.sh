@@ -5,15 +5,19 @@
 #   bash scripts/sanitize.sh                  # all areas
 #   bash scripts/sanitize.sh pipeline system  # only these areas
 #   JOBS=1 nice -n 19 bash scripts/sanitize.sh
+#   PRESET=asan-fast bash scripts/sanitize.sh # -O1 with asserts kept: the slow system tests in
+#                                             # minutes instead of hours (Debug OpenCV/Eigen at -O0)
 #
 # Each area's binary runs once as a whole (not one process per test through ctest) because
 # sanitizer start-up and Debug OpenCV/Eigen are slow. Leaks are reported (detect_leaks=1), and
 # the first UB report ends the binary (halt_on_error=1) so it cannot scroll by unnoticed.
-# Exit status: 0 only if every binary passed. Full logs: build-asan/sanitize-logs/<area>.log.
+# Exit status: 0 only if every binary passed. Full logs: build-<preset>/sanitize-logs/<area>.log.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
 JOBS=${JOBS:-$(nproc 2>/dev/null || echo 2)}
+PRESET=${PRESET:-asan}
+BUILD_DIR=build-${PRESET}
 ALL_AREAS=(platform runtime solver pipeline drivers devices tools system)
 if [ "$#" -gt 0 ]; then AREAS=("$@"); else AREAS=("${ALL_AREAS[@]}"); fi
 
@@ -23,17 +27,17 @@ export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/scripts/lsan_suppressions.txt:print_suppressions=0}
 
 start=$(date +%s)
-cmake --preset asan >/dev/null || exit 1
+cmake --preset "$PRESET" >/dev/null || exit 1
 targets=()
 for area in "${AREAS[@]}"; do
   targets+=("plumb_test_${area}")
   # tools/system tests run the built `plumb` tool, so build it with them.
   case "$area" in tools | system) targets+=(plumb) ;; esac
 done
-cmake --build build-asan -j "$JOBS" --target "${targets[@]}" || exit 1
+cmake --build "$BUILD_DIR" -j "$JOBS" --target "${targets[@]}" || exit 1
 built=$(date +%s)
 
-logs=build-asan/sanitize-logs
+logs=$BUILD_DIR/sanitize-logs
 mkdir -p "$logs"
 failed=()
 for area in "${AREAS[@]}"; do
@@ -41,7 +45,7 @@ for area in "${AREAS[@]}"; do
   echo "== ASan+UBSan: plumb_test_${area} =="
   t0=$(date +%s)
   # The working directory is the build dir, as for ctest (tests find ../shared by absolute path).
-  (cd build-asan && "./bin/plumb_test_${area}") >"$log" 2>&1
+  (cd "$BUILD_DIR" && "./bin/plumb_test_${area}") >"$log" 2>&1
   rc=$?
   t1=$(date +%s)
   # The gtest summary lines plus any sanitizer report headline.
