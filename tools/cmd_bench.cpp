@@ -19,7 +19,7 @@
 
 #include "drivers/dataset/camera_presets.h"
 #include "drivers/dataset/tum_dataset.h"
-#include "pipeline/feature_extractor.h"
+#include "pipeline/frontend/feature_extractor.h"
 #include "tools/args.h"
 #include "tools/command.h"
 

@@ -7,7 +7,7 @@
 #include <utility>
 
 #include "drivers/dataset/tum_dataset.h"
-#include "pipeline/feature_extractor.h"
+#include "pipeline/frontend/feature_extractor.h"
 #include "platform/allocation_counter.h"
 #include "runtime/chrome_trace.h"
 #include "runtime/clock.h"

@@ -24,7 +24,7 @@
 #include <string>
 
 #include "drivers/common/frame_source.h"
-#include "pipeline/odometry_system.h"
+#include "pipeline/odometry/odometry_system.h"
 #include "platform/status.h"
 #include "runtime/run_options.h"
 #include "runtime/run_report.h"

@@ -23,7 +23,7 @@
 
 #include "drivers/common/open_source.h"
 #include "drivers/trajectory/trajectory_io.h"
-#include "pipeline/odometry_system.h"
+#include "pipeline/odometry/odometry_system.h"
 #include "platform/monotonic_time.h"
 #include "platform/thread_control.h"
 #include "tools/staged_run.h"

@@ -3,8 +3,8 @@
 // synthetic scenes, our recordings, OpenNI2, V4L2. The pipeline's capture stage only sees this.
 #include <string>
 
-#include "pipeline/camera.h"
-#include "pipeline/rgbd_image.h"
+#include "sensor/camera.h"
+#include "sensor/rgbd_image.h"
 #include "platform/status.h"
 
 namespace plumb {

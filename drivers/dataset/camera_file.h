@@ -9,7 +9,7 @@
 // Format documented in docs/DATA_FORMATS.md.
 #include <string>
 
-#include "pipeline/camera.h"
+#include "sensor/camera.h"
 #include "platform/status.h"
 
 namespace plumb {

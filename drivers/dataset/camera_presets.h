@@ -9,7 +9,7 @@
 // All are 640x480 with depth factor 5000 (raw units per metre).
 #include <string>
 
-#include "pipeline/camera.h"
+#include "sensor/camera.h"
 #include "platform/status.h"
 
 namespace plumb {

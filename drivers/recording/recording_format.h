@@ -15,7 +15,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "pipeline/camera.h"
+#include "sensor/camera.h"
 #include "platform/status.h"
 
 namespace plumb {

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "drivers/recording/recording_format.h"
-#include "pipeline/camera.h"
-#include "pipeline/rgbd_image.h"
+#include "sensor/camera.h"
+#include "sensor/rgbd_image.h"
 #include "platform/status.h"
 
 namespace plumb {

@@ -8,8 +8,8 @@
 #include <memory>
 #include <string>
 
-#include "pipeline/camera.h"
-#include "pipeline/rgbd_image.h"
+#include "sensor/camera.h"
+#include "sensor/rgbd_image.h"
 #include "platform/status.h"
 
 namespace plumb {

@@ -20,7 +20,7 @@
 #include <opencv2/core.hpp>
 
 #include "drivers/synth/scene_model.h"
-#include "pipeline/camera.h"
+#include "sensor/camera.h"
 
 namespace plumb::synth {
 

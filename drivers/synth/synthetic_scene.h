@@ -21,8 +21,8 @@
 #include <Eigen/Geometry>
 
 #include "drivers/common/frame_source.h"
-#include "pipeline/camera.h"
-#include "pipeline/rgbd_image.h"
+#include "sensor/camera.h"
+#include "sensor/rgbd_image.h"
 #include "platform/status.h"
 
 namespace plumb {

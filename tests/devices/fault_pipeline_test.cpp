@@ -8,7 +8,7 @@
 #include "drivers/fault/fault_injecting_source.h"
 #include "drivers/fault/resilient_source.h"
 #include "drivers/synth/synthetic_scene.h"
-#include "pipeline/odometry_system.h"
+#include "pipeline/odometry/odometry_system.h"
 
 namespace plumb {
 namespace {

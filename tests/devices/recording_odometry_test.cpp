@@ -6,7 +6,7 @@
 
 #include "drivers/common/open_source.h"
 #include "drivers/recording/recording_writer.h"
-#include "pipeline/odometry_system.h"
+#include "pipeline/odometry/odometry_system.h"
 #include "tests/devices/device_test_util.h"
 
 namespace plumb {

@@ -5,9 +5,9 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include "pipeline/feature_extractor.h"
-#include "pipeline/image_pyramid.h"
-#include "pipeline/matcher.h"
+#include "pipeline/frontend/feature_extractor.h"
+#include "pipeline/frontend/image_pyramid.h"
+#include "pipeline/odometry/matcher.h"
 #include "platform/allocation_counter.h"
 #include "tests/pipeline/frontend_test_support.h"
 

@@ -2,7 +2,7 @@
 // (extract() returns false, output empty); a frame without depth gives 2D-only features.
 #include <gtest/gtest.h>
 
-#include "pipeline/feature_extractor.h"
+#include "pipeline/frontend/feature_extractor.h"
 #include "tests/pipeline/frontend_test_support.h"
 
 namespace plumb {

@@ -10,10 +10,10 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include "pipeline/frame_features.h"
-#include "pipeline/image_pyramid.h"
-#include "pipeline/line_descriptor.h"
-#include "pipeline/orb_descriptor.h"
+#include "pipeline/frontend/frame_features.h"
+#include "pipeline/frontend/image_pyramid.h"
+#include "pipeline/frontend/line_descriptor.h"
+#include "pipeline/frontend/orb_descriptor.h"
 
 namespace plumb {
 namespace {

@@ -7,8 +7,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "drivers/synth/synthetic_scene.h"
-#include "pipeline/camera.h"
-#include "pipeline/rgbd_image.h"
+#include "sensor/camera.h"
+#include "sensor/rgbd_image.h"
 
 namespace plumb::test {
 

@@ -14,9 +14,9 @@
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
-#include "pipeline/feature_extractor.h"
-#include "pipeline/line_extractor.h"
-#include "pipeline/line_fit3d.h"
+#include "pipeline/frontend/feature_extractor.h"
+#include "pipeline/frontend/line_extractor.h"
+#include "pipeline/frontend/line_fit3d.h"
 #include "tests/pipeline/frontend_test_support.h"
 
 namespace plumb {

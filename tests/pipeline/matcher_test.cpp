@@ -10,8 +10,8 @@
 
 #include <gtest/gtest.h>
 
-#include "pipeline/feature_extractor.h"
-#include "pipeline/matcher.h"
+#include "pipeline/frontend/feature_extractor.h"
+#include "pipeline/odometry/matcher.h"
 #include "tests/pipeline/frontend_test_support.h"
 
 namespace plumb {

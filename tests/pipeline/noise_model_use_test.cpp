@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "pipeline/feature_extractor.h"
+#include "pipeline/frontend/feature_extractor.h"
 #include "tests/pipeline/frontend_test_support.h"
 
 namespace plumb {

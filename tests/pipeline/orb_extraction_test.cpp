@@ -7,8 +7,8 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include "pipeline/feature_extractor.h"
-#include "pipeline/orb_fast.h"
+#include "pipeline/frontend/feature_extractor.h"
+#include "pipeline/frontend/orb_fast.h"
 #include "tests/pipeline/frontend_test_support.h"
 
 namespace plumb {

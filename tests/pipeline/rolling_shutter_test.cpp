@@ -11,7 +11,7 @@
 
 #include <gtest/gtest.h>
 
-#include "pipeline/tracker_rolling_shutter.h"
+#include "pipeline/odometry/tracker_rolling_shutter.h"
 #include "solver/se3.h"
 
 namespace plumb {

@@ -3,7 +3,7 @@
 // the keyframe window and the point array never exceeds the capacities.
 #include <gtest/gtest.h>
 
-#include "pipeline/map.h"
+#include "pipeline/odometry/map.h"
 #include "tests/system/odometry_test_util.h"
 
 namespace plumb::test {

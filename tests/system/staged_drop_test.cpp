@@ -9,7 +9,7 @@
 
 #include "drivers/synth/synthetic_scene.h"
 #include "drivers/trajectory/trajectory_io.h"
-#include "pipeline/odometry_system.h"
+#include "pipeline/odometry/odometry_system.h"
 #include "runtime/clock.h"
 #include "tools/staged_run.h"
 

@@ -1,0 +1,97 @@
+#pragma once
+// FrameFeatures: everything the front end measures in one frame, in fixed-capacity storage.
+// This is the contract between extraction (pipeline/ front end) and tracking/mapping.
+//
+// Coordinates: `px` is where a feature was detected on the raw image; `px_undist` (and every line
+// coefficient) is in the ideal pinhole image after undistortion, which is what matching by
+// projection and the solver use. 3D quantities are in the camera frame of this image, metres.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include <Eigen/Core>
+
+#include "pipeline/frontend/capacities.h"
+#include "pipeline/frontend/matcher_grid.h"
+#include "platform/fixed_vector.h"
+
+namespace plumb {
+
+// std::array of Eigen fixed-size types filled with `value`. `std::array<Eigen::Vector3f, N> a{}`
+// leaves the coefficients uninitialised (Eigen's default constructor does not zero), so a
+// LineObservation{} would copy garbage (and GCC warns -Wmaybe-uninitialized in emplace_back).
+template <typename T, std::size_t N>
+std::array<T, N> filledArray(const T& value) {
+  std::array<T, N> a;
+  a.fill(value);
+  return a;
+}
+
+// 256-bit binary descriptor: ORB's rotated BRIEF, or a 256-bit LBD code.
+struct Descriptor256 {
+  std::array<uint64_t, 4> words{};
+};
+
+inline int hammingDistance(const Descriptor256& a, const Descriptor256& b) {
+  return __builtin_popcountll(a.words[0] ^ b.words[0]) + __builtin_popcountll(a.words[1] ^ b.words[1]) +
+         __builtin_popcountll(a.words[2] ^ b.words[2]) + __builtin_popcountll(a.words[3] ^ b.words[3]);
+}
+
+struct KeypointObservation {
+  Eigen::Vector2f px = Eigen::Vector2f::Zero();         // detected pixel (raw image)
+  Eigen::Vector2f px_undist = Eigen::Vector2f::Zero();  // undistorted pixel
+  float angle_deg = 0;      // ORB orientation
+  float response = 0;       // FAST/Harris score
+  int8_t octave = 0;        // pyramid level it was detected on
+  float depth_m = 0;        // 0 = no valid depth: a 2D-only observation
+  float u_right = -1;       // u_undist - fx*b/depth (paper V-D); < 0 when no depth
+  Eigen::Vector3f P_cam = Eigen::Vector3f::Zero();       // back-projected point (depth_m > 0)
+  // Information (inverse covariance) of the [u, v, u_r] observation from the paper's noise model
+  // (pixel sigma from the octave, depth sigma quadratic in depth). Zero when depth_m == 0.
+  Eigen::Matrix3f info_uvr = Eigen::Matrix3f::Zero();
+};
+
+struct LineObservation {
+  Eigen::Vector2f start_px = Eigen::Vector2f::Zero();  // undistorted endpoints
+  Eigen::Vector2f end_px = Eigen::Vector2f::Zero();
+  // Normalised 2D line l = [a, b, c] / sqrt(a^2 + b^2) through the undistorted endpoints,
+  // so l . [u, v, 1] is the signed pixel distance of (u, v) to the line (paper eq. 1).
+  Eigen::Vector3d l = Eigen::Vector3d::Zero();
+  float length_px = 0;
+  float angle_rad = 0;      // direction of end - start in the image
+  int8_t octave = 0;        // pyramid level the segment was detected on
+  float response = 0;       // ranking score (e.g. length x gradient), best lines kept
+
+  // Line-guidance samples (paper section V-D): evenly spaced on the segment, back-projected with
+  // depth, outliers to the robust 3D line fit removed. Only the first num_samples are valid.
+  uint8_t num_samples = 0;
+  std::array<Eigen::Vector2f, kMaxLineSamples> sample_px =  // undistorted sample pixels
+      filledArray<Eigen::Vector2f, kMaxLineSamples>(Eigen::Vector2f::Zero());
+  std::array<Eigen::Vector3f, kMaxLineSamples> sample_P_cam =  // 3D samples, camera frame
+      filledArray<Eigen::Vector3f, kMaxLineSamples>(Eigen::Vector3f::Zero());
+  std::array<Eigen::Matrix3f, kMaxLineSamples> sample_cov =  // their 3D covariances
+      filledArray<Eigen::Matrix3f, kMaxLineSamples>(Eigen::Matrix3f::Zero());
+  // Robustly fitted 3D line (camera frame): a point on it and a unit direction; valid if has_3d.
+  bool has_3d = false;
+  Eigen::Vector3f line_point_cam = Eigen::Vector3f::Zero();
+  Eigen::Vector3f line_dir_cam = Eigen::Vector3f::Zero();
+};
+
+struct FrameFeatures {
+  FixedVector<KeypointObservation, kMaxKeypoints> keypoints;
+  FixedVector<Descriptor256, kMaxKeypoints> keypoint_descriptors;  // parallel to keypoints
+  FixedVector<LineObservation, kMaxLines> lines;
+  FixedVector<Descriptor256, kMaxLines> line_descriptors;  // LBD, parallel to lines
+  // Bucket grid over keypoints[i].px_undist, built by the extractor (matching by projection).
+  KeypointGrid keypoint_grid;
+
+  void clear() {
+    keypoints.clear();
+    keypoint_descriptors.clear();
+    lines.clear();
+    line_descriptors.clear();
+    keypoint_grid.built = false;
+  }
+};
+
+}  // namespace plumb

@@ -1,0 +1,208 @@
+#include "pipeline/frontend/image_pyramid.h"
+
+#include <cmath>
+#include <cstring>
+#include <utility>
+
+#include <opencv2/core/hal/intrin.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace plumb {
+
+ImagePyramid::ImagePyramid(int width, int height, int num_levels, float scale_factor)
+    : num_levels_(num_levels < 1 ? 1 : (num_levels > kPyramidLevels ? kPyramidLevels : num_levels)) {
+  std::array<cv::Size, kPyramidLevels> sizes;
+  int total_rows = 0;
+  for (int i = 0; i < num_levels_; ++i) {
+    scales_[i] = std::pow(scale_factor, static_cast<float>(i));
+    sizes[i] = cv::Size(static_cast<int>(std::lround(width / scales_[i])),
+                        static_cast<int>(std::lround(height / scales_[i])));
+    total_rows += sizes[i].height;
+  }
+  row_filtered_.create(1, width + 6, CV_16UC1);  // one padded row
+  high_row_.create(1, width + 8, CV_16SC1);  // + padding: see downsample()
+  low_row_.create(1, width + 8, CV_16SC1);
+  high_row_.setTo(0);
+  low_row_.setTo(0);
+  for (int i = 1; i < num_levels_; ++i) {
+    x_tap_start_[i] = static_cast<int>(x_taps_.size());
+    appendTaps(sizes[i - 1].width, sizes[i].width, x_taps_);
+    y_tap_start_[i] = static_cast<int>(y_taps_.size());
+    appendTaps(sizes[i - 1].height, sizes[i].height, y_taps_);
+  }
+  for (const Tap& t : x_taps_) {
+    // downsample() reads the pair (index0, index0 + 1): index1 may differ only with weight 0.
+    CV_Assert(t.index1 == t.index0 + 1 || t.weight == 0);
+    x_weight_pairs_.push_back(((1 << kWeightBits) - t.weight) | (t.weight << 16));
+  }
+  const cv::Mat kernel = cv::getGaussianKernel(7, 2.0, CV_64F);
+  int sum = 0;
+  for (int k = 0; k < 7; ++k) sum += kernel_[k] = static_cast<int>(std::lround(kernel.at<double>(k) * 256));
+  kernel_[3] += 256 - sum;  // exact unit gain
+  // blur() relies on the symmetry (rounding symmetric weights keeps them symmetric).
+  CV_Assert(kernel_[0] == kernel_[6] && kernel_[1] == kernel_[5] && kernel_[2] == kernel_[4]);
+  buffer_.create(total_rows, width, CV_8UC1);
+  blurred_buffer_.create(total_rows, width, CV_8UC1);
+  buffer_.setTo(0);
+  blurred_buffer_.setTo(0);
+  int row = 0;
+  for (int i = 0; i < num_levels_; ++i) {
+    const cv::Rect roi(0, row, sizes[i].width, sizes[i].height);
+    levels_[i] = buffer_(roi);
+    blurred_levels_[i] = blurred_buffer_(roi);
+    row += sizes[i].height;
+  }
+}
+
+void ImagePyramid::build(const cv::Mat& grey) {
+  grey.copyTo(levels_[0]);  // levels_[0] has the right size: copyTo writes in place
+  for (int i = 1; i < num_levels_; ++i) {
+    // Resize from the previous level (as ORB-SLAM does): cheap, and the 1.2 step keeps
+    // bilinear aliasing small.
+    downsample(i);
+  }
+  // 7x7, sigma 2: the smoothing rotated BRIEF is defined on.
+  for (int i = 0; i < num_levels_; ++i) blur(levels_[i], blurred_levels_[i]);
+}
+
+void ImagePyramid::appendTaps(int src_size, int dst_size, std::vector<Tap>& taps) {
+  const double step = static_cast<double>(src_size) / dst_size;
+  for (int d = 0; d < dst_size; ++d) {
+    const double f = (d + 0.5) * step - 0.5;  // source coordinate of the destination pixel centre
+    int index = static_cast<int>(std::floor(f));
+    double fraction = f - index;
+    if (index < 0) index = 0, fraction = 0;
+    if (index >= src_size - 1) index = src_size - 1, fraction = 0;
+    const int weight = static_cast<int>(std::lround(fraction * (1 << kWeightBits)));
+    taps.push_back({index, index + 1 < src_size ? index + 1 : index, weight});
+  }
+}
+
+void ImagePyramid::downsample(int level) {
+  const cv::Mat& src = levels_[level - 1];
+  cv::Mat& dst = levels_[level];
+  const Tap* x_taps = x_taps_.data() + x_tap_start_[level];
+  const int32_t* x_weights = x_weight_pairs_.data() + x_tap_start_[level];
+  const Tap* y_taps = y_taps_.data() + y_tap_start_[level];
+  const int one = 1 << kWeightBits;
+  constexpr int kRound = 1 << (2 * kWeightBits - 1);
+  // Each output pixel is the exact integer sum_ij p_ij * wy_i * wx_j (<= 255 * 2048^2, fits an
+  // int32), rounded once at the end, so the order of the passes and the split below do not
+  // change a single value.
+  // Vertical first: v = p0 * wy0 + p1 * wy1 (< 2^19) along contiguous source rows, 8 pixels per
+  // multiply-add of interleaved (row0, row1) 16-bit pairs against (wy0, wy1). v is kept as
+  // v = 1024 * high + low (high < 512, low < 1024) so the horizontal pass can also use 16-bit
+  // multiply-adds: v0 * wx0 + v1 * wx1 = 1024 * (high0 * wx0 + high1 * wx1) + (low0 * wx0 + low1 * wx1),
+  // where each (x0, x0 + 1) pair is one 32-bit read.
+  int16_t* high = high_row_.ptr<int16_t>(0);
+  int16_t* low = low_row_.ptr<int16_t>(0);
+  const cv::v_int32x4 low_mask = cv::v_setall_s32(1023), round = cv::v_setall_s32(kRound);
+  auto pairAt = [](const int16_t* row, int x) {  // (row[x], row[x + 1]) as one 32-bit lane
+    int32_t pair;
+    std::memcpy(&pair, row + x, sizeof(pair));
+    return pair;
+  };
+  for (int y = 0; y < dst.rows; ++y) {
+    const Tap& ty = y_taps[y];
+    const uint8_t* s0 = src.ptr<uint8_t>(ty.index0);
+    const uint8_t* s1 = src.ptr<uint8_t>(ty.index1);
+    const int w1 = ty.weight, w0 = one - w1;
+    const cv::v_int16x8 weights = cv::v_reinterpret_as_s16(cv::v_setall_s32(w0 | (w1 << 16)));
+    int x = 0;
+    for (; x + 8 <= src.cols; x += 8) {
+      const cv::v_int16x8 a = cv::v_reinterpret_as_s16(cv::v_load_expand(s0 + x));
+      const cv::v_int16x8 b = cv::v_reinterpret_as_s16(cv::v_load_expand(s1 + x));
+      cv::v_int16x8 lo, hi;
+      cv::v_zip(a, b, lo, hi);  // (a0, b0, a1, b1, ...)
+      const cv::v_int32x4 v_lo = cv::v_dotprod(lo, weights), v_hi = cv::v_dotprod(hi, weights);
+      cv::v_store(high + x, cv::v_pack(v_lo >> 10, v_hi >> 10));
+      cv::v_store(low + x, cv::v_pack(v_lo & low_mask, v_hi & low_mask));
+    }
+    for (; x < src.cols; ++x) {
+      const int v = s0[x] * w0 + s1[x] * w1;
+      high[x] = static_cast<int16_t>(v >> 10);
+      low[x] = static_cast<int16_t>(v & 1023);
+    }
+    // Horizontal. The clamped last tap reads the pair (x0, x0 + 1) with weights (2048, 0): the
+    // padding element past the row only ever meets a zero weight.
+    uint8_t* d = dst.ptr<uint8_t>(y);
+    int xd = 0;
+    for (; xd + 8 <= dst.cols; xd += 8) {
+      cv::v_int32x4 sums[2];
+      for (int g = 0; g < 2; ++g) {
+        const Tap* t = x_taps + xd + 4 * g;
+        const cv::v_int16x8 high_pairs = cv::v_reinterpret_as_s16(cv::v_int32x4(
+            pairAt(high, t[0].index0), pairAt(high, t[1].index0), pairAt(high, t[2].index0), pairAt(high, t[3].index0)));
+        const cv::v_int16x8 low_pairs = cv::v_reinterpret_as_s16(cv::v_int32x4(
+            pairAt(low, t[0].index0), pairAt(low, t[1].index0), pairAt(low, t[2].index0), pairAt(low, t[3].index0)));
+        const cv::v_int16x8 w = cv::v_reinterpret_as_s16(cv::v_load(x_weights + xd + 4 * g));
+        sums[g] = ((cv::v_dotprod(high_pairs, w) << 10) + cv::v_dotprod(low_pairs, w) + round) >> (2 * kWeightBits);
+      }
+      cv::v_pack_u_store(d + xd, cv::v_pack(sums[0], sums[1]));
+    }
+    for (; xd < dst.cols; ++xd) {
+      const Tap& t = x_taps[xd];
+      const int v0 = high[t.index0] * 1024 + low[t.index0], v1 = high[t.index1] * 1024 + low[t.index1];
+      d[xd] = static_cast<uint8_t>((v0 * one + (v1 - v0) * t.weight + kRound) >> (2 * kWeightBits));
+    }
+  }
+}
+
+void ImagePyramid::blur(const cv::Mat& src, cv::Mat& dst) {
+  // Separable, vertical pass first, 8.8 fixed point: the vertical sum (<= 255 * 256) is rounded
+  // back to 8 bits of range so the horizontal pass also fits 16-bit lanes (the lost fraction is far
+  // below what the binary tests can see). One padded 16-bit row buffer, reflected borders.
+  const int w = src.cols, h = src.rows;
+  auto reflect = [](int i, int n) { return i < 0 ? -i : (i >= n ? 2 * n - 2 - i : i); };  // REFLECT_101
+  uint16_t* t = row_filtered_.ptr<uint16_t>(0) + 3;  // t[-3 .. w+2] valid after padding
+  const uint16_t k[7] = {uint16_t(kernel_[0]), uint16_t(kernel_[1]), uint16_t(kernel_[2]), uint16_t(kernel_[3]),
+                         uint16_t(kernel_[4]), uint16_t(kernel_[5]), uint16_t(kernel_[6])};
+  cv::v_uint16x8 vk[7];
+  for (int i = 0; i < 7; ++i) vk[i] = cv::v_setall_u16(k[i]);
+  const cv::v_uint16x8 half = cv::v_setall_u16(128);
+  for (int y = 0; y < h; ++y) {
+    const uint8_t* r[7];
+    for (int i = 0; i < 7; ++i) r[i] = src.ptr<uint8_t>(reflect(y + i - 3, h));
+    int x = 0;
+    // The kernel is symmetric: rows 3 - i and 3 + i are added first (<= 510) and multiplied
+    // once, 4 multiplies instead of 7 for the same integer sum (<= 65280: no overflow).
+    for (; x + 16 <= w; x += 16) {
+      cv::v_uint16x8 lo, hi, a, b;
+      cv::v_expand(cv::v_load(r[3] + x), lo, hi);
+      lo = cv::v_mul_wrap(lo, vk[3]);
+      hi = cv::v_mul_wrap(hi, vk[3]);
+      for (int i = 0; i < 3; ++i) {
+        cv::v_uint16x8 c, e;
+        cv::v_expand(cv::v_load(r[i] + x), a, b);
+        cv::v_expand(cv::v_load(r[6 - i] + x), c, e);
+        lo += cv::v_mul_wrap(a + c, vk[i]);
+        hi += cv::v_mul_wrap(b + e, vk[i]);
+      }
+      cv::v_store(t + x, (lo + half) >> 8);
+      cv::v_store(t + x + 8, (hi + half) >> 8);
+    }
+    for (; x < w; ++x) {
+      unsigned acc = 0;
+      for (int i = 0; i < 7; ++i) acc += k[i] * r[i][x];
+      t[x] = static_cast<uint16_t>((acc + 128) >> 8);
+    }
+    for (int i = 1; i <= 3; ++i) {
+      t[-i] = t[reflect(-i, w)];
+      t[w - 1 + i] = t[reflect(w - 1 + i, w)];
+    }
+    uint8_t* d = dst.ptr<uint8_t>(y);
+    x = 0;
+    for (; x + 8 <= w; x += 8) {
+      cv::v_uint16x8 acc = cv::v_mul_wrap(cv::v_load(t + x), vk[3]);
+      for (int i = 0; i < 3; ++i) acc += cv::v_mul_wrap(cv::v_load(t + x + i - 3) + cv::v_load(t + x + 3 - i), vk[i]);
+      cv::v_pack_store(d + x, (acc + half) >> 8);
+    }
+    for (; x < w; ++x) {
+      unsigned acc = 0;
+      for (int i = 0; i < 7; ++i) acc += k[i] * t[x + i - 3];
+      d[x] = static_cast<uint8_t>((acc + 128) >> 8);
+    }
+  }
+}
+
+}  // namespace plumb

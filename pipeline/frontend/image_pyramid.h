@@ -1,0 +1,60 @@
+#pragma once
+// ImagePyramid: the grey image at num_levels scales (level i is 1/scale^i of level 0) plus a
+// Gaussian-blurred copy of every level for the binary descriptors.
+//
+// Allocation: build() allocates nothing. The blur is our own separable filter (cv::GaussianBlur
+// builds a filter engine, ~10 heap allocations per call) and so is the bilinear downsampler
+// (cv::resize allocates 2-3 small buffers per call); its sampling tables are built once here.
+//
+// All levels live as ROIs of ONE buffer whose row stride is level 0's width, so a pixel offset
+// (dy * stride + dx) means the same thing on every level: the rotated-BRIEF and FAST offset
+// tables are computed once. Buffers are allocated in the constructor; build() only writes.
+#include <array>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "pipeline/frontend/capacities.h"
+
+namespace plumb {
+
+class ImagePyramid {
+ public:
+  ImagePyramid(int width, int height, int num_levels, float scale_factor);
+
+  // grey: CV_8UC1 of the level-0 size. Fills every level and the blurred levels.
+  void build(const cv::Mat& grey);
+
+  int numLevels() const { return num_levels_; }
+  float scale(int level) const { return scales_[level]; }  // scale_factor^level
+  const cv::Mat& level(int i) const { return levels_[i]; }
+  const cv::Mat& blurred(int i) const { return blurred_levels_[i]; }
+  int stride() const { return static_cast<int>(buffer_.step[0]); }  // bytes per row, every level
+
+ private:
+  int num_levels_;
+  std::array<float, kPyramidLevels> scales_{};
+  void blur(const cv::Mat& src, cv::Mat& dst);
+  void downsample(int level);  // levels_[level - 1] -> levels_[level], bilinear
+
+  // Bilinear sampling table of one axis of one level: source index and the 11-bit fixed-point
+  // weight of index + 1 (weight of index is 2048 - that). Same half-pixel-centre convention as
+  // cv::resize INTER_LINEAR, so the pyramid is close to what OpenCV would give.
+  struct Tap {
+    int index0, index1;  // index1 = index0 + 1, clamped to the last pixel
+    int weight;          // of index1, in 1/2048
+  };
+  static constexpr int kWeightBits = 11;
+  static void appendTaps(int src_size, int dst_size, std::vector<Tap>& taps);
+  std::vector<Tap> x_taps_, y_taps_;                          // all levels, concatenated
+  std::array<int, kPyramidLevels> x_tap_start_{}, y_tap_start_{};  // each level's first entry
+  std::vector<int32_t> x_weight_pairs_;  // per x tap: (2048 - weight) | weight << 16, two int16 lanes
+  cv::Mat high_row_, low_row_;      // CV_16SC1, one source row + padding: the vertical pass, split
+
+  cv::Mat buffer_, blurred_buffer_;
+  cv::Mat row_filtered_;            // CV_16UC1, one row + 3 px padding each side: the blur's vertical pass
+  std::array<int, 7> kernel_{};     // 7-tap Gaussian, sigma 2, fixed point (sum 256)
+  std::array<cv::Mat, kPyramidLevels> levels_, blurred_levels_;
+};
+
+}  // namespace plumb

@@ -1,0 +1,254 @@
+#include "pipeline/frontend/line_segment_detector.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <cstring>
+
+#include <opencv2/core/hal/intrin.hpp>
+
+namespace plumb {
+namespace {
+
+constexpr int kBins = 1024;
+// Free = 1 so that a row of three states is directly a bit mask of the free pixels.
+constexpr uint8_t kFree = 1, kUsed = 0;
+// The region growing reads the states of p - 1 .. p + 2 as one little-endian word, so the state
+// array has one byte before pixel 0 and three after the last pixel.
+constexpr int kStateFront = 1, kStateBack = 3;
+static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "freeBits reads states as a little-endian word");
+
+// Four bytes widened to int32 lanes. OpenCV 4.6's SSE v_load_expand_q reads them through an
+// int*, which is undefined behaviour (UBSan: misaligned load) when the address is not a multiple
+// of 4; the x + 1 loads below never are. Copying into an aligned buffer first is defined;
+// compilers fold the copy into the same single 32-bit load.
+inline cv::v_int32x4 loadExpand4(const uint8_t* p) {
+  alignas(4) uint8_t bytes[4];
+  std::memcpy(bytes, p, sizeof(bytes));
+  return cv::v_reinterpret_as_s32(cv::v_load_expand_q(bytes));
+}
+
+}  // namespace
+
+LineSegmentDetector::LineSegmentDetector(int max_width, int max_height, const LineSegmentDetectorOptions& options)
+    : options_(options), max_width_(max_width), max_height_(max_height) {
+  CV_Assert(max_width < 32768 && max_height < 32768);  // region coordinates are int16
+  const size_t n = static_cast<size_t>(max_width) * max_height;
+  magnitude_.resize(n);
+  dir_x_.resize(n);
+  dir_y_.resize(n);
+  state_.resize(n + kStateFront + kStateBack, kUsed);
+  bucket_start_.resize(kBins + 1);
+  ordered_.resize(n);
+  region_.resize(n);
+  region_x_.resize(n);
+  region_y_.resize(n);
+  candidate_.resize(n);
+  candidate_bin_.resize(n);
+}
+
+int LineSegmentDetector::detect(const cv::Mat& image, float min_length, DetectedSegment* out, int capacity) {
+  CV_Assert(image.type() == CV_8UC1 && image.cols <= max_width_ && image.rows <= max_height_);
+  width_ = image.cols;
+  height_ = image.rows;
+  const int w = width_, h = height_;
+  const float tau = options_.angle_tolerance_deg * static_cast<float>(M_PI) / 180.f;
+  const float threshold = options_.quantization / std::sin(tau);
+  const float cos_tau = std::cos(tau);
+
+  // 2x2 gradient at (x + 0.5, y + 0.5); the last row and column have none. Four pixels per
+  // step in float lanes: the same IEEE operations in the same order as the scalar tail (sqrt and
+  // division are correctly rounded either way), so both give identical values.
+  const cv::v_float32x4 v_half = cv::v_setall_f32(0.5f), v_one = cv::v_setall_f32(1.f);
+  const cv::v_float32x4 v_zero = cv::v_setzero_f32(), v_threshold = cv::v_setall_f32(threshold);
+  cv::v_float32x4 v_max = cv::v_setzero_f32();
+  float max_magnitude = 0;
+  for (int y = 0; y < h; ++y) {
+    float* mag = magnitude_.data() + y * w;
+    float* ux = dir_x_.data() + y * w;
+    float* uy = dir_y_.data() + y * w;
+    uint8_t* st = state_.data() + kStateFront + y * w;
+    if (y == h - 1) {
+      std::fill_n(mag, w, 0.f);
+      std::fill_n(st, w, kUsed);
+      break;
+    }
+    const uint8_t* r0 = image.ptr<uint8_t>(y);
+    const uint8_t* r1 = image.ptr<uint8_t>(y + 1);
+    int x = 0;
+    for (; x + 4 < w; x += 4) {  // reads x .. x + 4: stays inside the row
+      const cv::v_int32x4 a = loadExpand4(r0 + x);
+      const cv::v_int32x4 b = loadExpand4(r0 + x + 1);
+      const cv::v_int32x4 c = loadExpand4(r1 + x);
+      const cv::v_int32x4 d = loadExpand4(r1 + x + 1);
+      const cv::v_float32x4 gx = v_half * cv::v_cvt_f32(b + d - a - c);
+      const cv::v_float32x4 gy = v_half * cv::v_cvt_f32(c + d - a - b);
+      const cv::v_float32x4 m = cv::v_sqrt(gx * gx + gy * gy);
+      const cv::v_float32x4 positive = m > v_zero;
+      const cv::v_float32x4 inv = cv::v_select(positive, v_one / m, v_zero);
+      cv::v_store(mag + x, m);
+      cv::v_store(ux + x, gx * inv);
+      cv::v_store(uy + x, gy * inv);
+      uint32_t above[4];
+      cv::v_store(above, cv::v_reinterpret_as_u32(m > v_threshold));
+      for (int i = 0; i < 4; ++i) st[x + i] = above[i] ? kFree : kUsed;
+      v_max = cv::v_max(v_max, m);
+    }
+    for (; x < w - 1; ++x) {
+      const int a = r0[x], b = r0[x + 1], c = r1[x], d = r1[x + 1];
+      const float gx = 0.5f * static_cast<float>(b + d - a - c);
+      const float gy = 0.5f * static_cast<float>(c + d - a - b);
+      const float m = std::sqrt(gx * gx + gy * gy);
+      mag[x] = m;
+      const float inv = m > 0 ? 1.f / m : 0.f;
+      ux[x] = gx * inv;
+      uy[x] = gy * inv;
+      st[x] = m > threshold ? kFree : kUsed;
+      max_magnitude = std::max(max_magnitude, m);
+    }
+    mag[w - 1] = 0;
+    st[w - 1] = kUsed;
+  }
+  max_magnitude = std::max(max_magnitude, cv::v_reduce_max(v_max));
+  if (max_magnitude <= threshold) return 0;
+
+  // Bucket sort of candidate pixels by magnitude, strongest bucket first, stable in raster
+  // order. One pass over the image collects candidates and their bins, the second only the
+  // candidates. Hot loops use local pointers: stores to the uint8_t state may alias anything,
+  // which would make the compiler reload every vector's data pointer.
+  const float bin_scale = (kBins - 1) / max_magnitude;
+  int* bucket_start = bucket_start_.data();
+  std::fill_n(bucket_start, kBins + 1, 0);
+  const int n = w * h;
+  const float* magnitude = magnitude_.data();
+  const float* dir_x = dir_x_.data();
+  const float* dir_y = dir_y_.data();
+  uint8_t* state = state_.data() + kStateFront;
+  int* candidate = candidate_.data();
+  uint16_t* candidate_bin = candidate_bin_.data();
+  int candidates = 0;
+  for (int i = 0; i < n; ++i) {
+    if (state[i] != kFree) continue;
+    const int bin = kBins - 1 - static_cast<int>(magnitude[i] * bin_scale);
+    candidate[candidates] = i;
+    candidate_bin[candidates++] = static_cast<uint16_t>(bin);
+    ++bucket_start[bin + 1];
+  }
+  for (int b = 0; b < kBins; ++b) bucket_start[b + 1] += bucket_start[b];
+  int* ordered = ordered_.data();
+  for (int k = 0; k < candidates; ++k) ordered[bucket_start[candidate_bin[k]]++] = candidate[k];
+
+  const int neighbour_offset[9] = {-w - 1, -w, -w + 1, -1, 0, 1, w - 1, w, w + 1};
+  int* region = region_.data();
+  int16_t* region_x = region_x_.data();
+  int16_t* region_y = region_y_.data();
+  int count = 0;
+  for (int k = 0; k < candidates && count < capacity; ++k) {
+    const int seed = ordered[k];
+    if (state[seed] != kFree) continue;
+    // Grow the region; its direction is the running (unnormalised) sum of unit gradients, whose
+    // norm (and so the alignment bound) only changes when a pixel joins.
+    state[seed] = kUsed;
+    region[0] = seed;
+    region_x[0] = static_cast<int16_t>(seed % w);
+    region_y[0] = static_cast<int16_t>(seed / w);
+    int size = 1;
+    float sum_x = dir_x[seed], sum_y = dir_y[seed];
+    float bound = cos_tau * std::sqrt(sum_x * sum_x + sum_y * sum_y);
+    // Neighbours in raster order (dy, then dx) as bits 0..8 of a mask of the free ones, read
+    // three states at a time; the set bits are then visited in the same order a plain 3x3 loop
+    // would (a neighbour can only change state when it is the one being added).
+    for (int r = 0; r < size; ++r) {
+      const int px = region_x[r], py = region_y[r];
+      const int p = region[r];
+      auto freeBits = [&](int i) {  // bits 0..2: states of i - 1, i, i + 1
+        uint32_t v;
+        std::memcpy(&v, state + i - 1, 4);
+        return (v & 1u) | ((v >> 7) & 2u) | ((v >> 14) & 4u);
+      };
+      uint32_t mask = freeBits(p) << 3;
+      if (py > 0) mask |= freeBits(p - w);
+      if (py < h - 1) mask |= freeBits(p + w) << 6;
+      if (px == 0) mask &= ~0111u;  // no left column
+      if (px == w - 1) mask &= ~0444u;  // no right column
+      while (mask != 0) {
+        const int bit = __builtin_ctz(mask);
+        mask &= mask - 1;
+        const int q = p + neighbour_offset[bit];
+        if (dir_x[q] * sum_x + dir_y[q] * sum_y < bound) continue;
+        state[q] = kUsed;
+        region[size] = q;
+        region_x[size] = static_cast<int16_t>(px + bit % 3 - 1);
+        region_y[size] = static_cast<int16_t>(py + bit / 3 - 1);
+        ++size;
+        sum_x += dir_x[q];
+        sum_y += dir_y[q];
+        bound = cos_tau * std::sqrt(sum_x * sum_x + sum_y * sum_y);
+      }
+    }
+    if (size < 4) continue;
+    if (regionToSegment(size, min_length, &out[count])) ++count;
+  }
+  return count;
+}
+
+bool LineSegmentDetector::regionToSegment(int size, float min_length, DetectedSegment* segment) const {
+  // An 8-connected region of `size` pixels spans at most (size - 1) * sqrt(2) along any axis:
+  // too small to reach min_length means the length test below would fail anyway.
+  if ((size - 1) * 1.5 + 1 < min_length) return false;
+  double sw = 0, cx = 0, cy = 0, gx = 0, gy = 0;
+  for (int i = 0; i < size; ++i) {
+    const int p = region_[i];
+    const double m = magnitude_[p];
+    sw += m;
+    cx += m * region_x_[i];
+    cy += m * region_y_[i];
+    gx += m * dir_x_[p];
+    gy += m * dir_y_[p];
+  }
+  cx /= sw;
+  cy /= sw;
+  double sxx = 0, syy = 0, sxy = 0;
+  for (int i = 0; i < size; ++i) {
+    const int p = region_[i];
+    const double m = magnitude_[p], dx = region_x_[i] - cx, dy = region_y_[i] - cy;
+    sxx += m * dx * dx;
+    syy += m * dy * dy;
+    sxy += m * dx * dy;
+  }
+  // Principal axis of the weighted scatter = the segment direction.
+  const double theta = 0.5 * std::atan2(2 * sxy, sxx - syy);
+  double ux = std::cos(theta), uy = std::sin(theta);
+  // Convention: the mean gradient points to the left of the direction (y down): flip if needed.
+  if (ux * gy - uy * gx > 0) {
+    ux = -ux;
+    uy = -uy;
+  }
+  double l_min = 1e30, l_max = -1e30, across2 = 0;
+  for (int i = 0; i < size; ++i) {
+    const int p = region_[i];
+    const double dx = region_x_[i] - cx, dy = region_y_[i] - cy;
+    const double along = dx * ux + dy * uy, across = -dx * uy + dy * ux;
+    l_min = std::min(l_min, along);
+    l_max = std::max(l_max, along);
+    across2 += magnitude_[p] * across * across;
+  }
+  const double across_rms = std::sqrt(across2 / sw);
+  const double length = l_max - l_min + 1;
+  // Straight and thin: the weighted RMS distance across the axis (curved or blob-like regions
+  // spread out) and the mean thickness (region pixels per unit length).
+  if (length < min_length || across_rms > options_.max_rms_width_px || size > options_.max_thickness_px * length) {
+    return false;
+  }
+  // The 2x2 gradient of pixel (x, y) sits at (x + 0.5, y + 0.5).
+  const double ox = cx + 0.5, oy = cy + 0.5;
+  segment->x0 = static_cast<float>(ox + l_min * ux);
+  segment->y0 = static_cast<float>(oy + l_min * uy);
+  segment->x1 = static_cast<float>(ox + l_max * ux);
+  segment->y1 = static_cast<float>(oy + l_max * uy);
+  segment->length = static_cast<float>(l_max - l_min);
+  segment->mean_gradient = static_cast<float>(sw / size);
+  return true;
+}
+
+}  // namespace plumb

@@ -1,0 +1,41 @@
+#pragma once
+// ORB orientation (intensity centroid) and 256-bit rotated BRIEF.
+//
+// The test pattern is 256 point pairs drawn once, deterministically, from an isotropic Gaussian
+// (sigma = patch/5, BRIEF's "G II" layout) and clipped to a disc of radius 13 px so that any
+// rotation stays inside the 31x31 patch. Rather than rotating the pattern per keypoint, it is
+// pre-rotated into 30 orientation bins of 12 degrees (as the ORB paper does) and stored as byte
+// offsets; this relies on every pyramid level sharing one row stride (see ImagePyramid).
+#include <array>
+#include <cstdint>
+
+#include <opencv2/core.hpp>
+
+#include "pipeline/frontend/frame_features.h"
+
+namespace plumb {
+
+class OrbDescriber {
+ public:
+  static constexpr int kPatchRadius = 15;   // intensity-centroid disc radius (31x31 patch)
+  static constexpr int kBorder = 16;        // keypoints must be this far from the level edge
+  static constexpr int kAngleBins = 30;
+
+  explicit OrbDescriber(int stride);
+
+  // Orientation in degrees [0, 360) of the patch centred at `p` (level image, shared stride).
+  float orientationDeg(const uint8_t* p) const;
+  // Rotated BRIEF on the blurred level at `p`.
+  void describe(const uint8_t* p_blurred, float angle_deg, Descriptor256& out) const;
+
+ private:
+  int stride_;
+  std::array<int, kPatchRadius + 1> disc_half_width_{};  // half row width of the disc at dy
+  // [bin][bit]: byte offsets of the first and the second sample of each test.
+  std::array<std::array<int, 256>, kAngleBins> first_offsets_{}, second_offsets_{};
+  // Per |dy|, weights of the pixels p[-15 .. 16] of rows +-dy for the intensity centroid: dx (or
+  // dy) inside the disc, 0 outside (16-bit multiply-adds, see orientationDeg).
+  alignas(16) std::array<std::array<int16_t, 32>, kPatchRadius + 1> x_weight_{}, y_weight_{};
+};
+
+}  // namespace plumb

@@ -1,0 +1,58 @@
+#pragma once
+// OrbExtractor: ORB keypoints spread over the image, written into FrameFeatures.
+//
+// Per pyramid level: FAST-9 with 3x3 suppression; the level's share of
+// num_features (geometric in the scale, as ORB-SLAM) is filled round-robin over grid cells
+// (every cell's best corner first, then every cell's second best, ...), each round strongest
+// first. FAST runs on the whole level at the high threshold, and again at the low threshold in
+// the cells that found nothing, so weak-texture regions still get keypoints (ORB-SLAM's
+// adaptive threshold). Then orientation by intensity centroid,
+// rotated BRIEF on the blurred level, and undistortion of the keypoint coordinate.
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "sensor/camera.h"
+#include "pipeline/frontend/extractor_options.h"
+#include "pipeline/frontend/frame_features.h"
+#include "pipeline/frontend/image_pyramid.h"
+#include "pipeline/frontend/orb_descriptor.h"
+#include "pipeline/frontend/orb_fast.h"
+
+namespace plumb {
+
+class OrbExtractor {
+ public:
+  OrbExtractor(const PinholeCamera& camera, const ExtractorOptions& options);
+
+  // grey: CV_8UC1 camera-sized. Builds the pyramid, appends keypoints + descriptors to `out`.
+  void extract(const cv::Mat& grey, FrameFeatures& out);
+
+  const ImagePyramid& pyramid() const { return pyramid_; }
+  double lastPyramidMs() const { return pyramid_ms_; }
+
+ private:
+  struct RankedCorner {
+    FastCorner corner;
+    int cell = 0;
+    int rank = 0;  // position within its cell, strongest first
+  };
+
+  void selectOnLevel(int level, int wanted, FrameFeatures& out);
+
+  PinholeCamera camera_;
+  ExtractorOptions options_;
+  ImagePyramid pyramid_;
+  FastDetector fast_;
+  OrbDescriber describer_;
+  std::array<int, kPyramidLevels> features_per_level_{};
+  // Sorting scratch, sized in the constructor, never grows: corners grouped by cell (ranked_),
+  // then by rank (by_rank_, which first holds each raw corner's cell), and the counting-sort
+  // bucket starts per cell and per rank.
+  std::vector<RankedCorner> ranked_, by_rank_;
+  std::vector<int> cell_start_, rank_start_;
+  std::vector<char> cell_has_corner_;  // per spreading cell of the current level (sized for 8 px cells)
+  double pyramid_ms_ = 0;
+};
+
+}  // namespace plumb

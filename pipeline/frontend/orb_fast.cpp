@@ -1,0 +1,172 @@
+#include "pipeline/frontend/orb_fast.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include <opencv2/core/hal/intrin.hpp>
+
+namespace plumb {
+namespace {
+
+// The 16 circle pixels, clockwise from the top.
+constexpr int kCircleX[16] = {0, 1, 2, 3, 3, 3, 2, 1, 0, -1, -2, -3, -3, -3, -2, -1};
+constexpr int kCircleY[16] = {-3, -3, -2, -1, 0, 1, 2, 3, 3, 3, 2, 1, 0, -1, -2, -3};
+
+}  // namespace
+
+int fastScore(const uint8_t* p, int stride) {
+  // Sliding minimum / maximum over windows of 9 by doubling (2, 4, 8, then +1): 4 passes of 16
+  // instead of 16 x 9 comparisons. Bright arcs need the minimum difference, dark arcs the maximum.
+  int d[32], lo2[32], hi2[32], lo4[32], hi4[32];
+  const int centre = *p;
+  for (int k = 0; k < 16; ++k) d[k] = d[k + 16] = p[kCircleY[k] * stride + kCircleX[k]] - centre;
+  for (int k = 0; k < 31; ++k) {
+    lo2[k] = std::min(d[k], d[k + 1]);
+    hi2[k] = std::max(d[k], d[k + 1]);
+  }
+  for (int k = 0; k < 29; ++k) {
+    lo4[k] = std::min(lo2[k], lo2[k + 2]);
+    hi4[k] = std::max(hi2[k], hi2[k + 2]);
+  }
+  int best = 0;
+  for (int k = 0; k < 16; ++k) {
+    const int lo9 = std::min(std::min(lo4[k], lo4[k + 4]), d[k + 8]);
+    const int hi9 = std::max(std::max(hi4[k], hi4[k + 4]), d[k + 8]);
+    best = std::max(best, std::max(lo9, -hi9));
+  }
+  return best;
+}
+
+FastDetector::FastDetector(int max_width, int max_height, int capacity)
+    : capacity_(capacity), score_(max_height, max_width, CV_8UC1, cv::Scalar(0)),
+      storage_(new FastCorner[2 * static_cast<size_t>(capacity)]) {
+  raw_ = storage_.get();
+  kept_ = storage_.get() + capacity;
+}
+
+void FastDetector::begin(const cv::Mat& image, int border) {
+  CV_Assert(image.type() == CV_8UC1 && image.cols <= score_.cols && image.rows <= score_.rows);
+  image_ = image;
+  border_ = std::max(border, 3);
+  dropped_ = 0;
+  num_raw_ = 0;
+  const int x_end = image.cols - border_, y_end = image.rows - border_;
+  for (int y = border_ - 1; y <= y_end; ++y) {
+    std::memset(score_.ptr<uint8_t>(y) + border_ - 1, 0, static_cast<size_t>(x_end - border_ + 2));
+  }
+}
+
+void FastDetector::scan(int threshold, int x0, int y0, int x1, int y1) {
+  const cv::Mat& image = image_;
+  const int stride = static_cast<int>(image.step[0]);
+  x0 = std::max(x0, border_);
+  y0 = std::max(y0, border_);
+  const int x_end = std::min(x1, image.cols - border_), y_end = std::min(y1, image.rows - border_);
+  threshold = std::clamp(threshold, 1, 254);
+
+  int circle[16];
+  for (int k = 0; k < 16; ++k) circle[k] = kCircleY[k] * stride + kCircleX[k];
+  // Unsigned byte comparisons as signed ones on values with the top bit flipped (SSE2 only has
+  // signed byte compares): a > b  <=>  (a ^ 0x80) > (b ^ 0x80).
+  const cv::v_uint8x16 t = cv::v_setall_u8(static_cast<uint8_t>(threshold));
+  const cv::v_int8x16 sign = cv::v_setall_s8(-128);
+  auto flip = [&sign](const cv::v_uint8x16& v) { return cv::v_reinterpret_as_s8(v) ^ sign; };
+  const cv::v_int8x16 nine = cv::v_setall_s8(9);
+  auto record = [&](uint8_t* score_row, int x, int y, int score) {
+    if (score <= threshold) return;
+    score_row[x] = static_cast<uint8_t>(std::min(score, 255));
+    if (num_raw_ < capacity_) raw_[num_raw_++] = FastCorner{int16_t(x), int16_t(y), uint8_t(std::min(score, 255))};
+    else ++dropped_;
+  };
+  // Max over the 16 cyclic arcs of 9 of the minimum of `diff` over the arc, by doubling:
+  // min over 2, 4, 8 consecutive, then the 9th.
+  auto arcScore = [](const cv::v_uint8x16* diff, cv::v_uint8x16 score) {
+    cv::v_uint8x16 m2[16], m4[16];
+    for (int k = 0; k < 16; ++k) m2[k] = cv::v_min(diff[k], diff[(k + 1) & 15]);
+    for (int k = 0; k < 16; ++k) m4[k] = cv::v_min(m2[k], m2[(k + 2) & 15]);
+    for (int k = 0; k < 16; ++k) {
+      score = cv::v_max(score, cv::v_min(cv::v_min(m4[k], m4[(k + 4) & 15]), diff[(k + 8) & 15]));
+    }
+    return score;
+  };
+  const int block_end = x_end - x0 >= 16 ? x_end : x0;  // rows narrower than a block: scalar only
+  for (int y = y0; y < y_end; ++y) {
+    const uint8_t* row = image.ptr<uint8_t>(y);
+    uint8_t* score_row = score_.ptr<uint8_t>(y);
+    // Blocks of 16 pixels; the last one is moved back to end at x_end, and its lanes below
+    // `first_lane` (done by the previous block) are ignored.
+    for (int x = x0; x < block_end;) {
+      const int bx = std::min(x, block_end - 16);
+      const int first_lane = x - bx;
+      x = bx + 16;
+      const cv::v_uint8x16 c = cv::v_load(row + bx);
+      const cv::v_int8x16 hi = flip(c + t), lo = flip(c - t);  // saturating
+      // Rejection test on the compass pixels 0, 4, 8, 12: an arc of 9 of the 16 always covers
+      // two neighbouring ones (0-4, 4-8, 8-12 or 12-0), i.e. (p0 or p8) and (p4 or p12).
+      const cv::v_int8x16 n = flip(cv::v_load(row + bx + circle[0])), e = flip(cv::v_load(row + bx + circle[4]));
+      const cv::v_int8x16 s = flip(cv::v_load(row + bx + circle[8])), w = flip(cv::v_load(row + bx + circle[12]));
+      const cv::v_int8x16 maybe = (((n > hi) | (s > hi)) & ((e > hi) | (w > hi))) |
+                                  (((n < lo) | (s < lo)) & ((e < lo) | (w < lo)));
+      if (!cv::v_check_any(maybe)) continue;
+      // Second filter, the full count: an arc of 9 needs >= 9 of the 16 pixels on one side. It
+      // also tells which sides can still have a corner, so only those get scored below.
+      cv::v_uint8x16 q[16];
+      cv::v_int8x16 bright = cv::v_setzero_s8(), dark = cv::v_setzero_s8();
+      for (int k = 0; k < 16; ++k) {
+        q[k] = cv::v_load(row + bx + circle[k]);
+        const cv::v_int8x16 f = flip(q[k]);
+        bright -= (f > hi);  // a true comparison is -1
+        dark -= (f < lo);
+      }
+      const cv::v_int8x16 maybe_bright = (bright >= nine) & maybe, maybe_dark = (dark >= nine) & maybe;
+      const bool any_bright = cv::v_check_any(maybe_bright), any_dark = cv::v_check_any(maybe_dark);
+      if (!any_bright && !any_dark) continue;
+      // Score in saturating u8 arithmetic: with b_k = sat(I_k - c) and e_k = sat(c - I_k), the
+      // score is the max over the 16 arcs of 9 of min(b) (bright side) or min(e) (dark side); a
+      // pixel is a corner exactly when its score exceeds the threshold (the segment test). Arcs
+      // of 9 of 16 cannot be bright and dark at once, so a corner's score is that of the side
+      // that passed the count: a side no lane can pass is skipped without changing any score.
+      cv::v_uint8x16 score = cv::v_setzero_u8();
+      cv::v_uint8x16 diff[16];
+      if (any_bright) {
+        for (int k = 0; k < 16; ++k) diff[k] = q[k] - c;
+        score = arcScore(diff, score);
+      }
+      if (any_dark) {
+        for (int k = 0; k < 16; ++k) diff[k] = c - q[k];
+        score = arcScore(diff, score);
+      }
+      const cv::v_uint8x16 candidates = cv::v_reinterpret_as_u8(maybe_bright | maybe_dark);
+      int mask = cv::v_signmask((score > t) & candidates) & (0xFFFF << first_lane);
+      if (!mask) continue;
+      uint8_t lane_score[16];
+      cv::v_store(lane_score, score);
+      while (mask) {
+        const int lane = __builtin_ctz(mask);
+        mask &= mask - 1;
+        record(score_row, bx + lane, y, lane_score[lane]);
+      }
+    }
+    for (int x = block_end > x0 ? x_end : x0; x < x_end; ++x) {
+      record(score_row, x, y, fastScore(row + x, stride));  // rows narrower than one block
+    }
+  }
+}
+
+int FastDetector::suppress() {
+  // 3x3 non-maximum suppression; a tie goes to the earlier pixel in raster order.
+  const int score_stride = static_cast<int>(score_.step[0]);
+  int num_kept = 0;
+  for (int i = 0; i < num_raw_; ++i) {
+    const FastCorner c = raw_[i];
+    const uint8_t* s = score_.ptr<uint8_t>(c.y) + c.x;
+    const int v = *s;
+    const bool is_max = v > s[-score_stride - 1] && v > s[-score_stride] && v > s[-score_stride + 1] &&
+                        v > s[-1] && v >= s[1] && v >= s[score_stride - 1] && v >= s[score_stride] &&
+                        v >= s[score_stride + 1];
+    if (is_max) kept_[num_kept++] = c;
+  }
+  return num_kept;
+}
+
+}  // namespace plumb

@@ -1,0 +1,133 @@
+#pragma once
+// LocalMapper: owns the Map. For each KeyframeRequest it
+//   1. inserts the keyframe (retiring the oldest one when the map is full) and its observations of
+//      the landmarks the tracker matched; applies the tracker's visibility counts;
+//   2. creates map points from the keyframe's depth for unmatched keypoints (closest first) and
+//      map lines (line guidance samples) for unmatched lines with a 3D fit;
+//   3. runs local BA on a bounded window (the keyframe and its best covisible neighbours optimised,
+//      keyframes outside the window that see the same landmarks fixed), writes poses, landmarks
+//      and pose covariances back, drops the observations BA classes as outliers;
+//   4. culls landmarks (found/visible ratio, too few observers, line samples failing BA);
+//   5. publishes a new LocalMap snapshot for the tracker.
+// Keyframes leaving the map are reported (final pose and covariance) through retired().
+#include <array>
+#include <cstdint>
+#include <memory>
+
+#include "sensor/camera.h"
+#include "pipeline/odometry/keyframe_request.h"
+#include "pipeline/odometry/local_map.h"
+#include "pipeline/odometry/map.h"
+#include "pipeline/odometry/odometry_options.h"
+#include "solver/camera_intrinsics.h"
+#include "solver/local_ba.h"
+
+namespace plumb {
+
+// A keyframe that left the map: its final state (written to the covariance output).
+struct RetiredKeyframe {
+  uint32_t id = 0;
+  uint64_t frame_sequence = 0;
+  double timestamp_s = 0;
+  Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  bool covariance_valid = false;
+};
+
+struct MapperStats {
+  uint64_t keyframes_inserted = 0;
+  uint64_t segments = 0;
+  uint64_t points_created = 0;
+  uint64_t lines_created = 0;
+  uint64_t points_culled = 0;
+  uint64_t lines_culled = 0;
+  uint64_t ba_runs = 0;
+  uint64_t ba_outlier_observations = 0;
+  uint64_t stale_associations = 0;  // request named a landmark that is gone meanwhile
+  MapCounts peak;                   // largest counts seen (capacity check)
+};
+
+struct InsertResult {
+  bool inserted = false;
+  uint32_t keyframe_id = 0;
+  int new_points = 0;
+  int new_lines = 0;
+  int ba_outliers = 0;
+  double ba_initial_cost = 0;
+  double ba_final_cost = 0;
+};
+
+class LocalMapper {
+ public:
+  LocalMapper(const PinholeCamera& camera, const OdometryOptions& options);
+  ~LocalMapper();
+  LocalMapper(const LocalMapper&) = delete;
+  LocalMapper& operator=(const LocalMapper&) = delete;
+
+  InsertResult insertKeyframe(const KeyframeRequest& request);
+  // The snapshot published after the last insertion (version 0 before any).
+  const LocalMap& localMap() const { return *local_map_; }
+  const Map& map() const { return map_; }
+  const MapperStats& stats() const { return stats_; }
+  uint32_t segment() const { return segment_; }
+
+  // Keyframes retired since the last clearRetired(), in retirement order.
+  const FixedVector<RetiredKeyframe, kMaxMapKeyframes>& retired() const { return retired_; }
+  void clearRetired() { retired_.clear(); }
+  // Retires every keyframe still in the map (end of a run), oldest first.
+  void retireAll();
+
+ private:
+  void retireKeyframe(int kf_slot);
+  void applyVisibility(const KeyframeRequest& request);
+  void addTrackedObservations(int kf_slot, const KeyframeRequest& request);
+  int createPoints(int kf_slot, const KeyframeRequest& request);
+  int createLines(int kf_slot, const KeyframeRequest& request);
+  void freePointSlots(std::size_t needed);
+  void freeLineSlots(std::size_t needed);
+  void cullLandmarks(uint32_t current_keyframe_id);
+  // local_mapper_ba.cpp
+  void runLocalBa(int kf_slot, InsertResult* result);
+  void selectWindow(int kf_slot);
+  // local_mapper_snapshot.cpp
+  void publishSnapshot(int kf_slot);
+  void rankCovisible(int kf_slot, int count, FixedVector<int, kMaxMapKeyframes>* out) const;
+
+  PinholeCamera camera_;
+  CameraIntrinsics intrinsics_;
+  OdometryOptions options_;
+  LocalBaOptions ba_options_;
+  Map map_;
+  LocalBundleAdjuster ba_;
+  uint32_t segment_ = 0;
+  uint64_t snapshot_version_ = 0;
+  MapperStats stats_;
+  FixedVector<RetiredKeyframe, kMaxMapKeyframes> retired_;
+
+  // Scratch, allocated once.
+  struct Scratch {
+    std::array<int32_t, kMaxMapPoints> point_ba_index{};      // -1: not in this BA
+    std::array<int32_t, kMaxMapLines> line_ba_first_index{};  // first sample's BA index
+    std::array<uint32_t, kMaxMapPoints> point_stamp{};
+    std::array<uint32_t, kMaxMapLines> line_stamp{};
+    FixedVector<int, kMaxMapKeyframes> window;        // optimised keyframe slots
+    FixedVector<int, kMaxMapKeyframes> fixed;         // fixed keyframe slots
+    std::array<int, kMaxMapKeyframes> ba_keyframe_index{};  // slot -> BA keyframe index
+    FixedVector<uint32_t, kMaxMapPoints> ba_points;   // BA landmark order: point slots ...
+    FixedVector<uint32_t, kMaxMapLines> ba_lines;     // ... then line slots (samples consecutive)
+    FixedVector<std::pair<float, uint16_t>, kMaxKeypoints> new_point_order;
+    FixedVector<std::pair<float, uint32_t>, kMaxMapPoints> retire_order;
+  };
+  // One BA observation, for writing outlier decisions back to the map.
+  struct BaObservation {
+    uint8_t kf_slot = 0;
+    bool is_line = false;
+    uint32_t slot = 0;
+  };
+  std::unique_ptr<Scratch> s_;
+  std::unique_ptr<LocalMap> local_map_;
+  std::vector<BaObservation> ba_observations_;  // reserved once (max BA observations)
+  uint32_t stamp_ = 0;
+};
+
+}  // namespace plumb

@@ -1,0 +1,209 @@
+// LocalMapper: the bounded-window local bundle adjustment around a new keyframe.
+#include <algorithm>
+
+#include "pipeline/odometry/local_mapper.h"
+
+namespace plumb {
+
+// Ranks the keyframes sharing landmarks with kf_slot by shared count (newer first on ties) and
+// returns the best `count` of them.
+void LocalMapper::rankCovisible(int kf_slot, int count, FixedVector<int, kMaxMapKeyframes>* out) const {
+  std::array<int, kMaxMapKeyframes> shared;
+  map_.covisibility(kf_slot, shared);
+  FixedVector<std::pair<int, int>, kMaxMapKeyframes> ranked;  // (-shared, -id) sorts best first
+  for (std::size_t i = 0; i < kMaxMapKeyframes; ++i) {
+    if (int(i) == kf_slot || shared[i] == 0 || !map_.keyframeAlive(int(i))) continue;
+    (void)ranked.push_back({-shared[i], -int(map_.keyframe(int(i)).id)});
+  }
+  std::sort(ranked.begin(), ranked.end());
+  out->clear();
+  for (const auto& r : ranked) {
+    if (int(out->size()) >= count) break;
+    (void)out->push_back(map_.findKeyframeSlot(uint32_t(-r.second)));
+  }
+}
+
+void LocalMapper::selectWindow(int kf_slot) {
+  const LocalMapperOptions& o = options_.mapper;
+  auto& window = s_->window;
+  rankCovisible(kf_slot, o.ba_optimised_keyframes - 1, &window);
+  // The new keyframe goes first.
+  (void)window.push_back(kf_slot);
+  std::rotate(window.begin(), window.end() - 1, window.end());
+
+  // Landmarks: everything the window observes, up to the BA's capacity (newest keyframe first).
+  ++stamp_;
+  s_->ba_points.clear();
+  s_->ba_lines.clear();
+  int landmarks = 0;
+  for (int slot : window) {
+    const Keyframe& kf = map_.keyframe(slot);
+    for (const auto& obs : kf.points) {
+      if (s_->point_stamp[obs.point_slot] == stamp_ || landmarks >= o.max_ba_landmarks) continue;
+      s_->point_stamp[obs.point_slot] = stamp_;
+      (void)s_->ba_points.push_back(obs.point_slot);
+      ++landmarks;
+    }
+    for (const auto& obs : kf.lines) {
+      const MapLine& l = map_.line(int(obs.line_slot));
+      if (s_->line_stamp[obs.line_slot] == stamp_ || landmarks + l.num_samples > o.max_ba_landmarks) continue;
+      s_->line_stamp[obs.line_slot] = stamp_;
+      (void)s_->ba_lines.push_back(obs.line_slot);
+      landmarks += l.num_samples;
+    }
+  }
+
+  // Fixed keyframes: outside the window, observing the most of those landmarks.
+  std::array<int, kMaxMapKeyframes> seen{};
+  KeyframeMask window_mask = 0;
+  for (int slot : window) window_mask |= KeyframeMask(1) << slot;
+  auto count_observers = [&seen, window_mask](KeyframeMask mask) {
+    mask &= ~window_mask;
+    while (mask) {
+      ++seen[__builtin_ctz(mask)];
+      mask &= mask - 1;
+    }
+  };
+  for (uint32_t p : s_->ba_points) count_observers(map_.point(int(p)).observers.mask);
+  for (uint32_t l : s_->ba_lines) count_observers(map_.line(int(l)).observers.mask);
+  FixedVector<std::pair<int, int>, kMaxMapKeyframes> ranked;
+  for (std::size_t i = 0; i < kMaxMapKeyframes; ++i) {
+    if (seen[i] > 0) (void)ranked.push_back({-seen[i], -int(map_.keyframe(int(i)).id)});
+  }
+  std::sort(ranked.begin(), ranked.end());
+  s_->fixed.clear();
+  for (const auto& r : ranked) {
+    if (int(s_->fixed.size()) >= o.ba_fixed_keyframes) break;
+    (void)s_->fixed.push_back(map_.findKeyframeSlot(uint32_t(-r.second)));
+  }
+}
+
+void LocalMapper::runLocalBa(int kf_slot, InsertResult* result) {
+  selectWindow(kf_slot);
+  auto& window = s_->window;
+  auto& fixed = s_->fixed;
+  // Gauge: with no keyframe outside the window, the oldest window keyframe is held fixed
+  // (ORB-SLAM fixes the map's first keyframe). A lone keyframe has nothing to adjust.
+  if (fixed.empty()) {
+    if (window.size() < 2) return;
+    auto oldest = std::min_element(window.begin(), window.end(), [this](int a, int b) {
+      return map_.keyframe(a).id < map_.keyframe(b).id;
+    });
+    (void)fixed.push_back(*oldest);
+    window.resize(std::size_t(std::remove(window.begin(), window.end(), *oldest) - window.begin()));
+  }
+
+  ba_.clear();
+  s_->ba_keyframe_index.fill(-1);
+  for (int slot : window) s_->ba_keyframe_index[slot] = ba_.addKeyframe(map_.keyframe(slot).T_world_cam.inverse(), false);
+  for (int slot : fixed) s_->ba_keyframe_index[slot] = ba_.addKeyframe(map_.keyframe(slot).T_world_cam.inverse(), true);
+
+  for (uint32_t p : s_->ba_points) s_->point_ba_index[p] = ba_.addLandmark(map_.point(int(p)).P_world);
+  for (uint32_t l : s_->ba_lines) {
+    const MapLine& line = map_.line(int(l));
+    s_->line_ba_first_index[l] = ba_.addLandmark(line.samples_world[0]);
+    for (int s = 1; s < line.num_samples; ++s) (void)ba_.addLandmark(line.samples_world[s]);
+  }
+
+  // Observations of the BA landmarks by every BA keyframe.
+  int num_obs = 0;
+  const int max_obs = int(ba_observations_.size());
+  auto add_keyframe_observations = [&](int slot) {
+    const int kf_index = s_->ba_keyframe_index[slot];
+    const Keyframe& kf = map_.keyframe(slot);
+    for (const auto& obs : kf.points) {
+      if (s_->point_stamp[obs.point_slot] != stamp_ || num_obs >= max_obs) continue;
+      const int landmark = s_->point_ba_index[obs.point_slot];
+      const int o = obs.has_depth
+                        ? ba_.addStereoPointObservation(kf_index, landmark, obs.uvr, obs.info)
+                        : ba_.addMonoPointObservation(kf_index, landmark, obs.uvr.head<2>(),
+                                                      obs.info.topLeftCorner<2, 2>());
+      if (o < 0) continue;
+      ba_observations_[std::size_t(o)] = BaObservation{uint8_t(slot), false, obs.point_slot};
+      num_obs = o + 1;
+    }
+    if (!options_.tracker.use_lines) return;
+    for (const auto& obs : kf.lines) {
+      if (s_->line_stamp[obs.line_slot] != stamp_) continue;
+      const MapLine& line = map_.line(int(obs.line_slot));
+      const int first = s_->line_ba_first_index[obs.line_slot];
+      for (int s = 0; s < line.num_samples && num_obs < max_obs; ++s) {
+        const int o = ba_.addLineObservation(kf_index, first + s, obs.l, obs.info);
+        if (o < 0) break;
+        ba_observations_[std::size_t(o)] = BaObservation{uint8_t(slot), true, obs.line_slot};
+        num_obs = o + 1;
+      }
+    }
+  };
+  for (int slot : window) add_keyframe_observations(slot);
+  for (int slot : fixed) add_keyframe_observations(slot);
+
+  const LocalBaSummary summary = ba_.solve(ba_options_);
+  ++stats_.ba_runs;
+  result->ba_initial_cost = summary.initial_cost;
+  result->ba_final_cost = summary.final_cost;
+  if (!summary.ok()) return;
+
+  // Write back poses, landmarks, covariances.
+  const bool have_covariance = ba_.computeCovariance(ba_options_);
+  for (int slot : window) {
+    Keyframe& kf = map_.keyframe(slot);
+    const int index = s_->ba_keyframe_index[slot];
+    kf.T_world_cam = ba_.pose(index).inverse();
+    if (have_covariance) {
+      kf.covariance = ba_.covariance(index);
+      kf.covariance_valid = true;
+    }
+  }
+  for (uint32_t p : s_->ba_points) map_.point(int(p)).P_world = ba_.landmark(s_->point_ba_index[p]);
+  for (uint32_t l : s_->ba_lines) {
+    MapLine& line = map_.line(int(l));
+    const int first = s_->line_ba_first_index[l];
+    Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+    for (int s = 0; s < line.num_samples; ++s) {
+      const Eigen::Vector3d updated = ba_.landmark(first + s);
+      shift += updated - line.samples_world[s];
+      line.samples_world[s] = updated;
+    }
+    shift /= double(line.num_samples);
+    line.start_world += shift;  // the segment's extent moves with its samples
+    line.end_world += shift;
+  }
+
+  // Outlier observations leave the map. A line observation goes when most of its samples fail.
+  int outliers = 0;
+  int o = 0;
+  while (o < num_obs) {
+    const BaObservation& obs = ba_observations_[std::size_t(o)];
+    if (!obs.is_line) {
+      if (ba_.isOutlier(o)) {
+        map_.removePointObservation(obs.kf_slot, int(obs.slot));
+        if (map_.point(int(obs.slot)).observers.mask == 0) map_.removePoint(int(obs.slot));
+        ++outliers;
+      }
+      ++o;
+      continue;
+    }
+    int total = 0, bad = 0;
+    const int start = o;
+    for (; o < num_obs && ba_observations_[std::size_t(o)].is_line &&
+           ba_observations_[std::size_t(o)].slot == obs.slot && ba_observations_[std::size_t(o)].kf_slot == obs.kf_slot &&
+           o - start < int(kMaxLineSamples);
+         ++o) {
+      ++total;
+      bad += ba_.isOutlier(o) ? 1 : 0;
+    }
+    MapLine& line = map_.line(int(obs.slot));
+    line.sample_evaluations += uint32_t(total);
+    line.sample_outliers += uint32_t(bad);
+    if (2 * bad > total) {
+      map_.removeLineObservation(obs.kf_slot, int(obs.slot));
+      if (line.observers.mask == 0) map_.removeLine(int(obs.slot));
+      ++outliers;
+    }
+  }
+  result->ba_outliers = outliers;
+  stats_.ba_outlier_observations += uint64_t(outliers);
+}
+
+}  // namespace plumb

@@ -1,0 +1,30 @@
+#pragma once
+// Compile-time capacities of the odometry map. Everything the map and its snapshots hold lives in
+// arrays of these sizes, allocated once when the system starts; when one is full the oldest or
+// worst entry is retired, so memory stays flat however long the system runs.
+#include <cstddef>
+#include <cstdint>
+
+#include "pipeline/frontend/capacities.h"
+
+namespace plumb {
+
+// Keyframes kept with their observations (the local-BA window is chosen among them). A landmark
+// records which of these slots observe it in a 32-bit mask, hence the limit of 32.
+constexpr std::size_t kMaxMapKeyframes = 32;
+using KeyframeMask = uint32_t;
+static_assert(kMaxMapKeyframes <= 8 * sizeof(KeyframeMask), "one mask bit per keyframe slot");
+
+constexpr std::size_t kMaxMapPoints = 8000;  // point landmarks
+constexpr std::size_t kMaxMapLines = 1500;   // line landmarks (each = up to kMaxLineSamples points)
+
+// What one LocalMap snapshot (the tracker's view of the map) can carry.
+constexpr std::size_t kMaxLocalMapPoints = 4000;
+constexpr std::size_t kMaxLocalMapLines = 600;
+
+// Keyframes remembered for relocalization only (pose + descriptors + 3D points in camera frame),
+// a ring independent of the map window.
+constexpr std::size_t kMaxRelocKeyframes = 200;
+constexpr std::size_t kMaxRelocFeatures = 500;
+
+}  // namespace plumb

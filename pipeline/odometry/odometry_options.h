@@ -1,0 +1,89 @@
+#pragma once
+// Options of the odometry system, one struct per component, defaults documented on the members.
+// tools/ fills them from the command line; nothing inside pipeline/ reads configuration itself.
+#include "pipeline/frontend/extractor_options.h"
+#include "pipeline/odometry/matcher.h"
+
+namespace plumb {
+
+struct TrackerOptions {
+  // Use line-guidance features in pose optimisation (false = the points-only baseline).
+  bool use_lines = true;
+  // Frame-to-frame matching: fewer matches than this triggers a retry with a wider window, then
+  // with zero motion (fast rotations break the constant-velocity guess).
+  int min_frame_matches = 25;
+  float wide_search_radius_px = 40;   // retry window at octave 0 (normal: the matcher's default)
+  // Local-map tracking: search radius around the projection of local landmarks (octave 0).
+  float local_map_search_radius_px = 4;
+  // Tracking state from the final inlier count (points + lines with a majority of inlier samples):
+  int min_inliers_ok = 40;    // >= this: ok
+  int min_inliers_weak = 15;  // >= this: weak (pose kept, a keyframe is forced), below: lost
+  // Pose optimisation: Gauss-Newton rounds, each followed by outlier classification (ORB-SLAM
+  // runs 4 rounds of 10 iterations with chi-square thresholds at 95%).
+  int pose_rounds = 4;
+  int pose_iterations_per_round = 10;
+  double chi2_stereo = 7.815;  // 3 dof, 95%
+  double chi2_mono = 5.991;    // 2 dof, 95%
+  double chi2_line = 3.841;    // 1 dof, 95%
+  // Landmarks farther than this (m) are not tracked (depth beyond it is too noisy to help).
+  double max_landmark_distance_m = 8.0;
+};
+
+struct KeyframePolicyOptions {
+  int max_frames_between = 30;       // ORB-SLAM: one second at 30 fps
+  int min_frames_between = 0;        // 0 = whenever the criteria below fire
+  float reference_ratio = 0.75f;     // inliers below this fraction of the reference KF's landmarks
+  float reference_ratio_few_keyframes = 0.4f;  // while the map holds < 2 keyframes
+  float close_depth_baselines = 40;  // "close" points: depth < this x baseline (ORB-SLAM: 40)
+  int min_tracked_close = 100;       // need-close rule: tracked close < this ...
+  int min_untracked_close = 70;      // ... and untracked close > this
+  int min_inliers = 15;              // never insert a keyframe with fewer inliers than this
+};
+
+struct LocalMapperOptions {
+  int ba_optimised_keyframes = 10;   // K: the new keyframe and its best covisible neighbours
+  int ba_fixed_keyframes = 6;        // keyframes outside the window observing its landmarks
+  int ba_iterations = 5;             // Levenberg-Marquardt iterations per keyframe
+  int max_ba_landmarks = 3000;       // points + line samples in one BA (extra ones are left out)
+  double chi2_stereo = 7.815;
+  double chi2_mono = 5.991;
+  double chi2_line = 3.841;
+  // New landmarks per keyframe (closest first, ORB-SLAM's RGB-D rule), and the depth range.
+  int max_new_points = 400;
+  int max_new_lines = 80;
+  double max_new_point_depth_m = 6.0;
+  // Culling (ORB-SLAM): found/visible below this ratio, or fewer than `min_observers` keyframes
+  // once `cull_after_keyframes` keyframes have passed since the landmark was made.
+  float min_found_ratio = 0.25f;
+  int min_observers = 2;
+  int cull_after_keyframes = 3;
+  float max_line_sample_outlier_ratio = 0.5f;  // lines whose BA samples fail this often go
+  int covisible_keyframes_in_local_map = 10;   // keyframes whose landmarks make the snapshot
+};
+
+struct RelocalizerOptions {
+  int hamming_threshold = 60;     // descriptor match acceptance
+  float ratio = 0.8f;             // Lowe ratio (best < ratio x second best)
+  int candidates = 5;             // keyframes verified geometrically, best match counts first
+  int prefilter_features = 200;   // current-frame features used to rank stored keyframes
+  int min_matches = 25;           // below: keyframe not tried
+  int ransac_iterations = 200;
+  double inlier_threshold_m = 0.05;  // 3D-3D residual of an inlier at 1 m (scaled by depth^2)
+  int min_inliers = 30;
+  uint64_t seed = 1;              // RANSAC sampling: fixed seed -> deterministic
+  int max_lost_frames_before_new_map = 10;  // M: then a new map segment starts
+};
+
+struct OdometryOptions {
+  ExtractorOptions extractor;
+  MatcherOptions matcher;
+  TrackerOptions tracker;
+  KeyframePolicyOptions keyframes;
+  LocalMapperOptions mapper;
+  RelocalizerOptions relocalizer;
+  // A map starts from a frame with this many keypoints with depth, or half of it plus lines.
+  int min_initial_points = 100;
+  int min_initial_lines = 10;
+};
+
+}  // namespace plumb

@@ -1,0 +1,35 @@
+#include "pipeline/odometry/odometry_trajectory.h"
+
+#include <algorithm>
+
+namespace plumb {
+
+OdometryTrajectory::OdometryTrajectory(int delay_frames)
+    : delay_(std::clamp(delay_frames, 0, kMaxDelayFrames - 1)) {}
+
+void OdometryTrajectory::push(uint64_t sequence, double timestamp_s, bool valid, const Eigen::Isometry3d& T_world_cam,
+                              uint32_t reference_id, const Eigen::Isometry3d& T_ref_cam) {
+  Pending& p = fifo_[(head_ + size_) % kMaxDelayFrames];
+  ++size_;
+  p.frame.sequence = sequence;
+  p.frame.timestamp_s = timestamp_s;
+  p.frame.valid = valid;
+  p.frame.dropped = false;
+  p.frame.T_world_cam = T_world_cam;
+  p.reference_id = valid ? reference_id : 0;
+  p.T_ref_cam = T_ref_cam;
+}
+
+FinishedFrame OdometryTrajectory::resolve(const LocalMap& map, const Pending& p) {
+  FinishedFrame out = p.frame;
+  if (p.reference_id == 0) return out;
+  for (const LocalMapKeyframe& kf : map.keyframes) {
+    if (kf.id == p.reference_id) {
+      out.T_world_cam = kf.T_world_cam * p.T_ref_cam;
+      break;
+    }
+  }
+  return out;
+}
+
+}  // namespace plumb

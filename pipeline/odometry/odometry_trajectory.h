@@ -1,0 +1,69 @@
+#pragma once
+// OdometryTrajectory: turns per-frame tracking results into the output trajectory.
+//
+// Frames are stored relative to their reference keyframe (T_ref_cam, ORB-SLAM style) and held in
+// a bounded FIFO for `delay_frames` frames; when a frame leaves the FIFO its pose is
+// T_world_ref * T_ref_cam with the reference keyframe's CURRENT (local-BA refined) pose, so the
+// corrections BA makes after the frame was tracked reach the trajectory. A reference keyframe no
+// longer in the map leaves the pose as tracked. delay_frames = 0 outputs every frame as tracked.
+#include <array>
+#include <cstdint>
+
+#include <Eigen/Geometry>
+
+#include "pipeline/odometry/local_map.h"
+
+namespace plumb {
+
+struct FinishedFrame {
+  uint64_t sequence = 0;
+  double timestamp_s = 0;
+  bool valid = false;  // false: no pose (lost / not initialised)
+  bool dropped = false;  // never processed (real-time replay found no free slot); valid is false
+  Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
+};
+
+class OdometryTrajectory {
+ public:
+  static constexpr int kMaxDelayFrames = 256;
+  explicit OdometryTrajectory(int delay_frames);
+
+  // Adds a frame. reference_id 0 = no reference (pose used as given).
+  void push(uint64_t sequence, double timestamp_s, bool valid, const Eigen::Isometry3d& T_world_cam,
+            uint32_t reference_id, const Eigen::Isometry3d& T_ref_cam);
+  // A frame the runtime dropped before processing: it keeps its place in the output order.
+  void pushDropped(uint64_t sequence, double timestamp_s) {
+    push(sequence, timestamp_s, false, Eigen::Isometry3d::Identity(), 0, Eigen::Isometry3d::Identity());
+    fifo_[(head_ + size_ - 1) % kMaxDelayFrames].frame.dropped = true;
+  }
+  // Frames leaving the FIFO, resolved against the keyframe poses of `map`; calls fn(FinishedFrame)
+  // for each. flushAll empties the FIFO (end of run).
+  template <typename Fn>
+  void popReady(const LocalMap& map, Fn fn) { pop(map, false, fn); }
+  template <typename Fn>
+  void flushAll(const LocalMap& map, Fn fn) { pop(map, true, fn); }
+
+ private:
+  struct Pending {
+    FinishedFrame frame;
+    uint32_t reference_id = 0;
+    Eigen::Isometry3d T_ref_cam = Eigen::Isometry3d::Identity();
+  };
+  template <typename Fn>
+  void pop(const LocalMap& map, bool all, Fn fn) {
+    while (size_ > 0 && (all || size_ > delay_)) {
+      Pending& p = fifo_[head_];
+      head_ = (head_ + 1) % kMaxDelayFrames;
+      --size_;
+      fn(resolve(map, p));
+    }
+  }
+  static FinishedFrame resolve(const LocalMap& map, const Pending& p);
+
+  int delay_;
+  std::array<Pending, kMaxDelayFrames> fifo_{};
+  int head_ = 0;
+  int size_ = 0;
+};
+
+}  // namespace plumb

@@ -1,0 +1,231 @@
+#include "pipeline/odometry/relocalizer.h"
+
+#include <algorithm>
+#include <random>
+
+#include <Eigen/Geometry>
+
+#include "solver/noise_model.h"
+#include "solver/pose_optimizer.h"
+
+namespace plumb {
+
+struct Relocalizer::Scratch {
+  FixedVector<std::pair<float, uint16_t>, kMaxKeypoints> order;
+  FixedVector<std::pair<int, int>, kMaxRelocKeyframes> ranked;  // (-score, ring index)
+  FixedVector<uint16_t, kMaxKeypoints> prefilter;
+  FixedVector<Correspondence, kMaxKeypoints> correspondences;
+  std::array<bool, kMaxKeypoints> inlier{};
+  std::array<bool, kMaxKeypoints> best_inlier{};
+  FixedVector<PosePointObservation, kMaxKeypoints> pose_points;
+  std::array<bool, kMaxKeypoints> pose_inlier{};
+};
+
+Relocalizer::Relocalizer(const PinholeCamera& camera, const OdometryOptions& options)
+    : camera_(camera),
+      options_(options),
+      stored_(std::make_unique<std::array<StoredKeyframe, kMaxRelocKeyframes>>()),
+      s_(std::make_unique<Scratch>()) {
+  intrinsics_ = CameraIntrinsics{camera.fx, camera.fy, camera.cx, camera.cy, camera.fx * camera.baseline_m};
+}
+
+Relocalizer::~Relocalizer() = default;
+
+void Relocalizer::addKeyframe(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam,
+                              const FrameFeatures& frame) {
+  StoredKeyframe& kf = (*stored_)[next_];
+  next_ = (next_ + 1) % kMaxRelocKeyframes;
+  count_ = std::min(count_ + 1, kMaxRelocKeyframes);
+  kf.id = keyframe_id;
+  kf.T_world_cam = T_world_cam;
+  kf.descriptors.clear();
+  kf.P_cam.clear();
+  // The strongest keypoints with depth (index breaks response ties: deterministic).
+  auto& order = s_->order;
+  order.clear();
+  for (std::size_t k = 0; k < frame.keypoints.size(); ++k) {
+    if (frame.keypoints[k].depth_m > 0) (void)order.push_back({-frame.keypoints[k].response, uint16_t(k)});
+  }
+  const std::size_t keep = std::min(order.size(), kMaxRelocFeatures);
+  std::partial_sort(order.begin(), order.begin() + keep, order.end());
+  for (std::size_t i = 0; i < keep; ++i) {
+    (void)kf.descriptors.push_back(frame.keypoint_descriptors[order[i].second]);
+    (void)kf.P_cam.push_back(frame.keypoints[order[i].second].P_cam);
+  }
+}
+
+void Relocalizer::updatePose(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam) {
+  for (std::size_t i = 0; i < count_; ++i) {
+    if ((*stored_)[i].id == keyframe_id) (*stored_)[i].T_world_cam = T_world_cam;
+  }
+}
+
+int Relocalizer::countMatches(const StoredKeyframe& kf, const FrameFeatures& frame) const {
+  int matches = 0;
+  for (uint16_t k : s_->prefilter) {
+    const Descriptor256& d = frame.keypoint_descriptors[k];
+    int best = 256;
+    for (const Descriptor256& other : kf.descriptors) best = std::min(best, hammingDistance(d, other));
+    matches += best <= options_.relocalizer.hamming_threshold;
+  }
+  return matches;
+}
+
+int Relocalizer::matchAll(const StoredKeyframe& kf, const FrameFeatures& frame) {
+  auto& out = s_->correspondences;
+  out.clear();
+  const RelocalizerOptions& o = options_.relocalizer;
+  for (std::size_t k = 0; k < frame.keypoints.size(); ++k) {
+    if (frame.keypoints[k].depth_m <= 0) continue;
+    const Descriptor256& d = frame.keypoint_descriptors[k];
+    int best = 256, second = 256, best_index = -1;
+    for (std::size_t j = 0; j < kf.descriptors.size(); ++j) {
+      const int dist = hammingDistance(d, kf.descriptors[j]);
+      if (dist < best) {
+        second = best;
+        best = dist;
+        best_index = int(j);
+      } else if (dist < second) {
+        second = dist;
+      }
+    }
+    if (best_index < 0 || best > o.hamming_threshold || float(best) >= o.ratio * float(second)) continue;
+    (void)out.push_back(Correspondence{uint16_t(k), frame.keypoints[k].P_cam.cast<double>(),
+                                       kf.P_cam[std::size_t(best_index)].cast<double>()});
+  }
+  return int(out.size());
+}
+
+namespace {
+
+// Rigid transform (no scale) mapping `from` onto `to`, least squares (Umeyama / Horn).
+Eigen::Isometry3d rigidFit(const Eigen::Matrix<double, 3, Eigen::Dynamic>& from,
+                           const Eigen::Matrix<double, 3, Eigen::Dynamic>& to) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.matrix() = Eigen::umeyama(from, to, false);
+  return T;
+}
+
+}  // namespace
+
+// RANSAC over minimal 3-point rigid fits. The inlier threshold grows with depth squared like the
+// sensor noise (inlier_threshold_m at 1 m).
+bool Relocalizer::ransac(Eigen::Isometry3d* T_stored_current, int* inliers) {
+  const auto& c = s_->correspondences;
+  const int n = int(c.size());
+  const RelocalizerOptions& o = options_.relocalizer;
+  std::mt19937 rng(uint32_t(o.seed));
+  std::uniform_int_distribution<int> pick(0, n - 1);
+  Eigen::Matrix3d from, to;
+  int best = 0;
+  auto count_inliers = [&](const Eigen::Isometry3d& T, std::array<bool, kMaxKeypoints>& flags) {
+    int count = 0;
+    for (int i = 0; i < n; ++i) {
+      const double depth = std::max(1.0, c[i].P_stored.z());
+      const double threshold = o.inlier_threshold_m * depth * depth;
+      flags[i] = (T * c[i].P_current - c[i].P_stored).squaredNorm() < threshold * threshold;
+      count += flags[i];
+    }
+    return count;
+  };
+  for (int it = 0; it < o.ransac_iterations; ++it) {
+    const int a = pick(rng), b = pick(rng), d = pick(rng);
+    if (a == b || a == d || b == d) continue;
+    from << c[a].P_current, c[b].P_current, c[d].P_current;
+    to << c[a].P_stored, c[b].P_stored, c[d].P_stored;
+    // Nearly collinear samples give an ill-defined rotation.
+    if ((to.col(1) - to.col(0)).cross(to.col(2) - to.col(0)).norm() < 1e-4) continue;
+    const Eigen::Isometry3d T = rigidFit(from, to);
+    const int count = count_inliers(T, s_->inlier);
+    if (count > best) {
+      best = count;
+      *T_stored_current = T;
+      s_->best_inlier = s_->inlier;
+    }
+  }
+  if (best < 3) return false;
+  // Refit on all inliers (dynamic matrices: only on the rare lost frames).
+  Eigen::Matrix<double, 3, Eigen::Dynamic> all_from(3, best), all_to(3, best);
+  int j = 0;
+  for (int i = 0; i < n; ++i) {
+    if (!s_->best_inlier[i]) continue;
+    all_from.col(j) = c[i].P_current;
+    all_to.col(j) = c[i].P_stored;
+    ++j;
+  }
+  *T_stored_current = rigidFit(all_from, all_to);
+  *inliers = count_inliers(*T_stored_current, s_->best_inlier);
+  return true;
+}
+
+int Relocalizer::refine(const FrameFeatures& frame, const StoredKeyframe& kf, Eigen::Isometry3d* T_cam_world) {
+  const auto& c = s_->correspondences;
+  auto& points = s_->pose_points;
+  points.clear();
+  const NoiseModelOptions& noise = options_.extractor.noise;
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    if (!s_->best_inlier[i]) continue;
+    const KeypointObservation& kp = frame.keypoints[c[i].keypoint];
+    PosePointObservation* obs = points.emplace_back();
+    obs->P_world = kf.T_world_cam * c[i].P_stored;
+    obs->has_depth = kp.depth_m > 0;
+    obs->z = Eigen::Vector3d(kp.px_undist.x(), kp.px_undist.y(), obs->has_depth ? kp.u_right : 0.0);
+    obs->information = kp.info_uvr.cast<double>();
+    if (!obs->has_depth || !(obs->information.trace() > 0)) {
+      obs->information.setZero();
+      obs->information.topLeftCorner<2, 2>() = monoPointInformation(noise, kp.octave);
+      obs->has_depth = false;
+    }
+  }
+  PoseOptimizerOptions pose_options;
+  const PoseResult pose = optimizePose(intrinsics_, *T_cam_world, points.data(), int(points.size()), nullptr, 0,
+                                       pose_options, s_->pose_inlier.data(), nullptr);
+  *T_cam_world = pose.T_cam_world;
+  return pose.num_point_inliers;
+}
+
+RelocResult Relocalizer::relocalize(const FrameFeatures& frame, Eigen::Isometry3d* T_world_cam) {
+  RelocResult result;
+  const RelocalizerOptions& o = options_.relocalizer;
+  // A deterministic subset spread over the keypoint list for ranking.
+  s_->prefilter.clear();
+  int with_depth = 0;
+  for (const auto& kp : frame.keypoints) with_depth += kp.depth_m > 0;
+  if (with_depth < o.min_inliers) return result;
+  const int step = std::max(1, with_depth / std::max(1, o.prefilter_features));
+  int seen = 0;
+  for (std::size_t k = 0; k < frame.keypoints.size(); ++k) {
+    if (frame.keypoints[k].depth_m <= 0) continue;
+    if (seen++ % step == 0) (void)s_->prefilter.push_back(uint16_t(k));
+  }
+
+  s_->ranked.clear();
+  for (std::size_t i = 0; i < count_; ++i) {
+    const int score = countMatches((*stored_)[i], frame);
+    // Scaled to the full feature count for the min_matches comparison.
+    if (score * step >= o.min_matches) (void)s_->ranked.push_back({-score, int(i)});
+  }
+  std::sort(s_->ranked.begin(), s_->ranked.end());
+  for (std::size_t r = 0; r < s_->ranked.size() && int(r) < o.candidates; ++r) {
+    const StoredKeyframe& kf = (*stored_)[std::size_t(s_->ranked[r].second)];
+    ++result.candidates_tried;
+    const int matches = matchAll(kf, frame);
+    if (matches < o.min_matches) continue;
+    Eigen::Isometry3d T_stored_current;
+    int inliers = 0;
+    if (!ransac(&T_stored_current, &inliers) || inliers < o.min_inliers) continue;
+    Eigen::Isometry3d T_cam_world = (kf.T_world_cam * T_stored_current).inverse();
+    const int refined = refine(frame, kf, &T_cam_world);
+    result.matches = matches;
+    result.ransac_inliers = inliers;
+    result.refined_inliers = refined;
+    if (refined < o.min_inliers) continue;
+    result.success = true;
+    result.keyframe_id = kf.id;
+    *T_world_cam = T_cam_world.inverse();
+    return result;
+  }
+  return result;
+}
+
+}  // namespace plumb

@@ -1,0 +1,90 @@
+// Tracker: pose-only optimisation over the current associations, and pruning of the outliers.
+#include "pipeline/odometry/tracker.h"
+#include "solver/noise_model.h"
+
+namespace plumb {
+
+PoseResult Tracker::optimizeAndPrune(const FrameFeatures& frame, const Eigen::Isometry3d& T_cam_world,
+                                     TrackResult* result) {
+  const NoiseModelOptions& noise = options_.extractor.noise;
+  auto& points = b_->pose_points;
+  auto& point_keypoint = b_->pose_point_keypoint;
+  auto& lines = b_->pose_lines;
+  auto& line_index = b_->pose_line_index;
+  points.clear();
+  point_keypoint.clear();
+  lines.clear();
+  line_index.clear();
+
+  for (std::size_t k = 0; k < frame.keypoints.size(); ++k) {
+    if (!b_->points[k].valid) continue;
+    const KeypointObservation& kp = frame.keypoints[k];
+    PosePointObservation* obs = points.emplace_back();
+    obs->P_world = b_->points[k].P_world;
+    obs->has_depth = kp.depth_m > 0;  // u_r itself may be negative near the left border
+    obs->z = Eigen::Vector3d(kp.px_undist.x(), kp.px_undist.y(), obs->has_depth ? kp.u_right : 0.0);
+    if (obs->has_depth) {
+      obs->information = kp.info_uvr.cast<double>();
+      if (!(obs->information.trace() > 0)) {
+        obs->information = stereoPointInformation(noise, intrinsics_, kp.octave, kp.depth_m);
+      }
+    } else {
+      obs->information.setZero();
+      obs->information.topLeftCorner<2, 2>() = monoPointInformation(noise, kp.octave);
+    }
+    (void)point_keypoint.push_back(uint16_t(k));
+  }
+  if (options_.tracker.use_lines) {
+    for (std::size_t k = 0; k < frame.lines.size(); ++k) {
+      const LineAssociation& a = b_->lines[k];
+      if (!a.valid) continue;
+      const double information = lineSampleInformation(noise, frame.lines[k].octave);
+      for (int s = 0; s < a.num_samples; ++s) {
+        PoseLineObservation* obs = lines.emplace_back();
+        if (obs == nullptr) break;
+        obs->P_world = a.samples_world[s];
+        obs->line = frame.lines[k].l;
+        obs->information = information;
+        (void)line_index.push_back(uint16_t(k));
+      }
+    }
+  }
+
+  const PoseResult pose =
+      optimizePose(intrinsics_, T_cam_world, points.data(), int(points.size()), lines.data(),
+                   int(lines.size()), pose_options_, b_->point_inlier.data(), b_->line_inlier.data());
+
+  // Outliers lose their association (they are not used again for this frame nor carried on).
+  result->point_inliers = 0;
+  result->line_inliers = 0;
+  result->landmark_inliers = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    PointAssociation& a = b_->points[point_keypoint[i]];
+    if (!b_->point_inlier[i]) {
+      a = PointAssociation{};
+      continue;
+    }
+    ++result->point_inliers;
+    if (a.landmark.id != 0) ++result->landmark_inliers;
+  }
+  // A line counts as an inlier when most of its samples are.
+  std::size_t i = 0;
+  while (i < lines.size()) {
+    const uint16_t k = line_index[i];
+    int total = 0, good = 0;
+    for (; i < lines.size() && line_index[i] == k; ++i) {
+      ++total;
+      good += b_->line_inlier[i] ? 1 : 0;
+    }
+    LineAssociation& a = b_->lines[k];
+    if (2 * good <= total) {
+      a = LineAssociation{};
+      continue;
+    }
+    ++result->line_inliers;
+    if (a.landmark.id != 0) ++result->landmark_inliers;
+  }
+  return pose;
+}
+
+}  // namespace plumb
