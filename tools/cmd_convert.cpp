@@ -3,7 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "drivers/common/open_source.h"
+#include "drivers/open/open_source.h"
 #include "drivers/recording/recording_source.h"
 #include "drivers/recording/recording_writer.h"
 #include "drivers/recording/tum_folder_writer.h"

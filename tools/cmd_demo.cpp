@@ -7,7 +7,9 @@
 
 #include "tools/args.h"
 #include "tools/command.h"
-#include "tools/odometry_session.h"
+#include "drivers/synth/synth_spec.h"
+#include "drivers/trajectory/evaluate.h"
+#include "tools/run_outputs.h"
 
 namespace plumb::tools {
 namespace {
@@ -44,8 +46,8 @@ int runDemo(int argc, char** argv) {
   const long frames = args.getInt("frames", 600, &ok);
   const long seed = args.getInt("seed", 1, &ok);
   const long line_samples = args.getInt("line-samples", 5, &ok);
-  if (!ok || frames <= 0 || seed < 0 || line_samples < 0 || line_samples > long(kMaxLineSamples)) {
-    std::fprintf(stderr, "plumb demo: --frames > 0, --seed >= 0, --line-samples 0..%zu\n", kMaxLineSamples);
+  if (!ok || frames <= 0 || seed < 0 || line_samples < 0 || line_samples == 1 || line_samples > long(kMaxLineSamples)) {
+    std::fprintf(stderr, "plumb demo: --frames > 0, --seed >= 0, --line-samples 0 or 2..%zu\n", kMaxLineSamples);
     return 2;
   }
 
@@ -64,21 +66,27 @@ int runDemo(int argc, char** argv) {
       std::fprintf(stderr, "plumb demo: %s\n", st.message().c_str());
       return 1;
     }
-    SessionOptions options;
-    setLineOptions(int(line_samples), run.lines, &options.system);
-    SessionResult result;
-    st = runSession(*source, options, &result);
+    SystemOptions system_options;
+    setLineSamples(int(line_samples), run.lines, &system_options.odometry);
+    RunOutputOptions output_options;
+    output_options.expected_frames = source->frameCount();
+    RunOutputs outputs(output_options);
+    RunRecord record;
+    st = runToOutputs(*source, system_options, OdometryRunOptions{}, outputs, &record);
     if (!st.ok()) {
       std::fprintf(stderr, "plumb demo: %s: %s\n", run.preset, st.message().c_str());
       return 1;
     }
-    double ate = -1;
-    st = ateRmse(syntheticGroundTruth(source->scene(), result.frames), result.trajectory, &ate);
+    AteResult ate;
+    st = evaluateAte(syntheticGroundTruth(source->scene(), long(outputs.statistics().frames())), outputs.trajectory(),
+                     AteOptions{}, &ate);
     if (!st.ok()) std::fprintf(stderr, "plumb demo: %s: no ATE: %s\n", run.preset, st.message().c_str());
-    std::printf("%-12s %-12s %7ld %7llu %10.4f %9.2f %9.2f %6llu\n", run.preset,
-                run.lines ? "points+lines" : "points", result.frames,
-                (unsigned long long)(result.stats.frames_lost + result.stats.frames_not_initialized), ate,
-                result.total_ms.mean(), result.total_ms.percentile(99), (unsigned long long)result.stats.keyframes);
+    const runtime::LatencyHistogram& total = outputs.statistics().totalNs();
+    std::printf("%-12s %-12s %7llu %7llu %10.4f %9.2f %9.2f %6llu\n", run.preset,
+                run.lines ? "points+lines" : "points", (unsigned long long)outputs.statistics().frames(),
+                (unsigned long long)(record.odometry.frames_lost + record.odometry.frames_not_initialized),
+                st.ok() ? ate.translation_m.rmse : -1.0, total.meanNs() * 1e-6,
+                double(total.percentileNs(0.99)) * 1e-6, (unsigned long long)record.odometry.keyframes);
     std::fflush(stdout);
   }
   return 0;

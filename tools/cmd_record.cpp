@@ -3,7 +3,7 @@
 #include <csignal>
 #include <cstdio>
 
-#include "drivers/common/open_source.h"
+#include "drivers/open/open_source.h"
 #include "drivers/recording/recording_writer.h"
 #include "tools/args.h"
 #include "tools/command.h"

@@ -1,7 +1,8 @@
 // plumb_bench_staged_odometry [DATASET_DIR] [--frames N] [--repeat N] [--rt-priority P] [--trace-dir DIR]
 // The runtime acceptance numbers on one sequence (default: fr1/rpy head250):
-//   1. the single-threaded processImage() loop (reference trajectory, frames per second);
-//   2. --mode deterministic three times: trajectories byte-identical to each other and to (1);
+//   1. --mode deterministic, the lock-step schedule of the stages on one thread: the single-threaded
+//      program (reference trajectory, frames per second);
+//   2. --mode deterministic three more times: trajectories byte-identical to (1);
 //   3. --mode fast: frames per second over (1)  (target >= 1.6 on 2 cores); (1) and (3) are run
 //      --repeat times (default 3), alternating, and the best run of each is compared: on a shared
 //      machine other jobs only ever slow a run down;
@@ -21,12 +22,13 @@
 #include <string>
 #include <vector>
 
-#include "drivers/common/open_source.h"
+#include "drivers/common/source_capture.h"
+#include "drivers/open/open_source.h"
 #include "drivers/trajectory/trajectory_io.h"
-#include "pipeline/odometry/odometry_system.h"
+#include "pipeline/run/odometry_run.h"
+#include "runtime/chrome_trace.h"
 #include "platform/monotonic_time.h"
 #include "platform/thread_control.h"
-#include "tools/staged_run.h"
 
 namespace plumb {
 namespace {
@@ -70,71 +72,61 @@ Status open(const std::string& dir, std::unique_ptr<FrameSource>* source) {
   return openFrameSource(dir, "", source);
 }
 
-Status runSingleThreadedNow(const std::string& dir, long frames, Trajectory* out);
-
 // The calling thread back to normal scheduling (after a SCHED_FIFO single-threaded run).
 void normalScheduling() {
   sched_param param{};
   (void)pthread_setschedparam(pthread_self(), SCHED_OTHER, &param);
 }
 
-Status runSingleThreaded(const std::string& dir, long frames, Trajectory* out, int realtime_priority = 0) {
-  if (realtime_priority > 0) (void)applyThreadSettings(ThreadSettings{"", -1, realtime_priority});
-  const Status status = runSingleThreadedNow(dir, frames, out);
-  if (realtime_priority > 0) normalScheduling();
-  return status;
-}
-
-Status runSingleThreadedNow(const std::string& dir, long frames, Trajectory* out) {
-  std::unique_ptr<FrameSource> source;
-  PLUMB_RETURN_IF_ERROR(open(dir, &source));
-  OdometrySystem system(source->camera(), SystemOptions{});
-  auto on_frame = [&](const FinishedFrame& f) { append(out, f.timestamp_s, f.valid, f.T_world_cam); };
-  RgbdImage image;
-  const double cpu_start = processCpuSeconds();
-  const int64_t start = monotonicNowNs();
-  while (out->frames < frames) {
-    const int64_t t_read = monotonicNowNs();
-    const SourceResult r = source->next(image);
-    if (r == SourceResult::kEndOfStream) break;
-    if (r != SourceResult::kFrame) return source->lastError();
-    out->decode_ms += static_cast<double>(monotonicNowNs() - t_read) * 1e-6;
-    const FrameOutput& output = system.processImage(image);
-    out->extract_ms += output.extract_ms;
-    out->odometry_ms += output.track_ms + output.map_ms;
-    system.drainFinishedFrames(on_frame);
-    ++out->frames;
+// Keeps the output trajectory in the bench's reserved storage.
+class TrajectorySink final : public OdometrySink {
+ public:
+  explicit TrajectorySink(Trajectory* out) : out_(out) {}
+  Status onFrame(const FrameOutput& output) override {
+    if (!output.dropped) ++out_->frames;
+    return Status::Ok();
   }
-  system.finish(on_frame, [](const RetiredKeyframe&) {});
-  out->seconds = static_cast<double>(monotonicNowNs() - start) * 1e-9;
-  out->cpu_seconds = processCpuSeconds() - cpu_start;
-  out->format();
-  return Status::Ok();
+  Status onFinishedFrame(const FinishedFrame& f) override {
+    append(out_, f.timestamp_s, f.valid, f.T_world_cam);
+    return Status::Ok();
+  }
+
+ private:
+  Trajectory* out_;
+};
+
+// Mean milliseconds of a stage (index into the report: 0 = capture) over its frames.
+double meanStageMs(const runtime::RunReport& report, std::size_t stage) {
+  return stage < report.stages.size() ? report.stages[stage].latency.meanNs() * 1e-6 : 0.0;
 }
 
 Status runMode(const std::string& dir, long frames, runtime::RunMode mode, const std::string& trace,
-               Trajectory* out, tools::StagedRunResult* result, int realtime_priority = 0) {
+               Trajectory* out, OdometryRunResult* result, int realtime_priority = 0) {
   std::unique_ptr<FrameSource> source;
   PLUMB_RETURN_IF_ERROR(open(dir, &source));
-  OdometrySystem system(source->camera(), SystemOptions{});
-  auto on_frame = [&](const FinishedFrame& f) { append(out, f.timestamp_s, f.valid, f.T_world_cam); };
-  tools::StagedRunOptions options;
-  options.mode = mode;
+  std::unique_ptr<OdometrySystem> system;
+  PLUMB_RETURN_IF_ERROR(OdometrySystem::create(source->camera(), SystemOptions{}, &system));
+  OdometryRunOptions options;
+  options.schedule.mode = mode;
+  options.schedule.realtime_priority = realtime_priority;
   options.max_frames = frames;
-  options.profile_path = trace;
-  options.print_profile = false;
-  options.realtime_priority = realtime_priority;
-  const tools::FrameOutputFn on_output = [&](const FrameOutput& output) {
-    system.drainFinishedFrames(on_frame);
-    if (!output.dropped) ++out->frames;
-    return Status::Ok();
-  };
+  options.keep_trace = !trace.empty();
+  TrajectorySink sink(out);
+  SourceCapture capture(*source);
+  // Lock-step runs on this thread: with --rt-priority it runs SCHED_FIFO like the stage threads.
+  const bool fifo_here = mode == runtime::RunMode::kDeterministic && realtime_priority > 0;
+  if (fifo_here) (void)applyThreadSettings(ThreadSettings{"", -1, realtime_priority});
   const double cpu_start = processCpuSeconds();
   const int64_t start = monotonicNowNs();
-  PLUMB_RETURN_IF_ERROR(tools::runStaged(*source, system, options, on_output, result));
-  system.finish(on_frame, [](const RetiredKeyframe&) {});
+  const Status status = runOdometry(capture, *system, sink, options, result);
   out->seconds = static_cast<double>(monotonicNowNs() - start) * 1e-9;
   out->cpu_seconds = processCpuSeconds() - cpu_start;
+  if (fifo_here) normalScheduling();
+  PLUMB_RETURN_IF_ERROR(status);
+  if (!trace.empty()) PLUMB_RETURN_IF_ERROR(runtime::writeChromeTrace(trace, result->trace, result->report));
+  out->decode_ms = meanStageMs(result->report, 0) * double(out->frames);
+  out->extract_ms = meanStageMs(result->report, 1) * double(out->frames);
+  out->odometry_ms = (meanStageMs(result->report, 2) + meanStageMs(result->report, 3)) * double(out->frames);
   out->format();
   return Status::Ok();
 }
@@ -172,8 +164,9 @@ int main(int argc, char** argv) {
   };
 
   Trajectory single;
-  check(runSingleThreaded(dir, frames, &single, rt_priority));
-  std::printf("single-threaded processImage loop: %ld frames, %.2f s, %.2f frames/s\n", single.frames,
+  OdometryRunResult single_result;
+  check(runMode(dir, frames, runtime::RunMode::kDeterministic, "", &single, &single_result, rt_priority));
+  std::printf("single-threaded (deterministic lock-step): %ld frames, %.2f s, %.2f frames/s\n", single.frames,
               single.seconds, single.frames / single.seconds);
   // What two idle cores could give: the pipeline runs at the pace of its slowest stage or of half
   // the total work, whichever is slower. A load-independent yardstick for the measured ratio.
@@ -186,7 +179,7 @@ int main(int argc, char** argv) {
   bool identical = true;
   for (int run = 0; run < 3; ++run) {
     Trajectory t;
-    tools::StagedRunResult r;
+    OdometryRunResult r;
     check(runMode(dir, frames, runtime::RunMode::kDeterministic, "", &t, &r));
     const bool same = t.tum == single.tum;
     identical = identical && same;
@@ -195,14 +188,14 @@ int main(int argc, char** argv) {
   }
 
   Trajectory fast;
-  tools::StagedRunResult fast_result;
+  OdometryRunResult fast_result;
   check(runMode(dir, frames, runtime::RunMode::kFast, trace("fast.json"), &fast, &fast_result, rt_priority));
   double best_single_fps = single.frames / single.seconds;
   double best_fast_fps = fast.frames / fast.seconds;
   for (int run = 1; run < repeat; ++run) {
     Trajectory s, f;
-    tools::StagedRunResult r;
-    check(runSingleThreaded(dir, frames, &s, rt_priority));
+    OdometryRunResult r;
+    check(runMode(dir, frames, runtime::RunMode::kDeterministic, "", &s, &r, rt_priority));
     check(runMode(dir, frames, runtime::RunMode::kFast, "", &f, &r, rt_priority));
     best_single_fps = std::max(best_single_fps, s.frames / s.seconds);
     best_fast_fps = std::max(best_fast_fps, f.frames / f.seconds);
@@ -216,13 +209,13 @@ int main(int argc, char** argv) {
               fast.tum == single.tum ? "byte-identical to" : "differs from");
   std::printf("allocations after frame 30: %llu over %llu frames (%.1f per frame)\n",
               static_cast<unsigned long long>(fast_result.allocations_after_warmup),
-              static_cast<unsigned long long>(fast_result.frames_after_warmup),
-              fast_result.frames_after_warmup
-                  ? static_cast<double>(fast_result.allocations_after_warmup) / fast_result.frames_after_warmup
+              static_cast<unsigned long long>(fast_result.allocation_frames),
+              fast_result.allocation_frames
+                  ? static_cast<double>(fast_result.allocations_after_warmup) / fast_result.allocation_frames
                   : 0.0);
 
   Trajectory realtime;
-  tools::StagedRunResult realtime_result;
+  OdometryRunResult realtime_result;
   check(runMode(dir, frames, runtime::RunMode::kRealtime, trace("realtime.json"), &realtime, &realtime_result,
                 rt_priority));
   std::printf("\nrealtime%s:\n%s", rt_priority > 0 ? " (SCHED_FIFO stage threads)" : "",

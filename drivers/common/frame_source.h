@@ -1,6 +1,7 @@
 #pragma once
 // FrameSource: the one interface every producer of RGB-D frames implements — dataset replay,
 // synthetic scenes, our recordings, OpenNI2, V4L2. The pipeline's capture stage only sees this.
+#include <cstddef>
 #include <string>
 
 #include "sensor/camera.h"
@@ -28,6 +29,9 @@ class FrameSource {
   // For live sources: try to reopen after an error (returns the outcome). Replays: no-op error.
   virtual Status reopen() { return Status::Error(describe() + ": cannot be reopened"); }
   virtual bool isLive() const { return false; }
+  // Frames a finite source will deliver, when known in advance (a dataset folder, a synthetic
+  // scene); 0 when unknown (live sensors, recordings). Lets callers reserve memory once.
+  virtual std::size_t frameCount() const { return 0; }
 };
 
 }  // namespace plumb

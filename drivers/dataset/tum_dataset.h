@@ -51,6 +51,7 @@ class TumDatasetSource : public FrameSource {
   // Random access (does not move the replay cursor). Fills out.sequence = i.
   Status load(std::size_t i, RgbdImage& out);
   std::size_t size() const { return frames_.size(); }
+  std::size_t frameCount() const override { return frames_.size(); }
   double timestamp(std::size_t i) const { return frames_[i].rgb_timestamp_s; }
   const TumFrameEntry& entry(std::size_t i) const { return frames_[i]; }
   // True when the pairs were read from associations.txt (false: associated here).

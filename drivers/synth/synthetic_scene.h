@@ -98,6 +98,7 @@ class SyntheticSource : public FrameSource {
   const PinholeCamera& camera() const override;
   std::string describe() const override;  // "synth:<preset>:seed=<seed>"
   const Status& lastError() const override;
+  std::size_t frameCount() const override { return std::size_t(scene_->numFrames()); }
 
   const SyntheticScene& scene() const { return *scene_; }
   int nextIndex() const { return next_index_; }

@@ -1,6 +1,8 @@
 #pragma once
 // Options of the odometry system, one struct per component, defaults documented on the members.
 // tools/ fills them from the command line; nothing inside pipeline/ reads configuration itself.
+#include <algorithm>
+
 #include "pipeline/frontend/extractor_options.h"
 #include "pipeline/odometry/matcher.h"
 
@@ -85,5 +87,15 @@ struct OdometryOptions {
   int min_initial_points = 100;
   int min_initial_lines = 10;
 };
+
+// N line-guidance samples per line (paper: 5), and whether lines are used at all. A 3D line fit
+// needs min_line_inliers samples (default 3); with N = 2 both must be inliers, so it becomes N.
+// N = 0 (or use_lines false) is the points-only system. N = 1 is left as given: validate() in
+// pipeline/odometry/odometry_system.h refuses it (one sample fixes no 3D line).
+inline void setLineSamples(int samples, bool use_lines, OdometryOptions* options) {
+  options->extractor.line_samples = samples;
+  if (samples >= 2) options->extractor.min_line_inliers = std::min(options->extractor.min_line_inliers, samples);
+  options->tracker.use_lines = use_lines && samples > 0;
+}
 
 }  // namespace plumb

@@ -15,7 +15,6 @@ struct OdometryStats {
   uint64_t relocalizations = 0;
   uint64_t relocalization_attempts = 0;
   uint64_t segments = 0;                // maps started (1 = never restarted)
-  uint64_t extraction_failures = 0;     // image did not match the camera
 };
 
 }  // namespace plumb

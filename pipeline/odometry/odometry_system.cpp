@@ -1,6 +1,8 @@
 #include "pipeline/odometry/odometry_system.h"
 
 #include <chrono>
+#include <cmath>
+#include <string>
 
 namespace plumb {
 
@@ -12,37 +14,50 @@ double millisecondsSince(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
+Status validate(const SystemOptions& options) {
+  const std::string extractor = validate(options.odometry.extractor);
+  if (!extractor.empty()) return Status::Error("extractor options: " + extractor);
+  if (options.odometry.extractor.line_samples == 1) {
+    // A line landmark is a 3D line fitted through its samples: one sample fixes no direction, so
+    // N = 1 could only ever mean "no lines" -- refused rather than silently changed.
+    return Status::Error("line samples must be 0 (points only) or 2.." + std::to_string(kMaxLineSamples) +
+                         ": a 3D line needs at least two samples");
+  }
+  if (options.odometry.extractor.line_samples > 0 &&
+      options.odometry.extractor.min_line_inliers > options.odometry.extractor.line_samples) {
+    return Status::Error("min_line_inliers (" + std::to_string(options.odometry.extractor.min_line_inliers) +
+                         ") exceeds line_samples (" + std::to_string(options.odometry.extractor.line_samples) +
+                         "): no line could ever be fitted");
+  }
+  if (options.output_delay_frames < 0 || options.output_delay_frames >= OdometryTrajectory::kMaxDelayFrames) {
+    return Status::Error("output delay must be within 0.." + std::to_string(OdometryTrajectory::kMaxDelayFrames - 1) +
+                         " frames");
+  }
+  return Status::Ok();
+}
+
+Status OdometrySystem::create(const PinholeCamera& camera, const SystemOptions& options,
+                              std::unique_ptr<OdometrySystem>* out) {
+  PLUMB_RETURN_IF_ERROR(validate(options));
+  if (!(camera.width > 0 && camera.height > 0 && std::isfinite(camera.fx) && std::isfinite(camera.fy) &&
+        camera.fx != 0 && camera.fy != 0)) {
+    return Status::Error("camera: needs a positive image size and finite, non-zero focal lengths");
+  }
+  out->reset(new OdometrySystem(camera, options));
+  return Status::Ok();
+}
+
 OdometrySystem::OdometrySystem(const PinholeCamera& camera, const SystemOptions& options)
     : camera_(camera),
       options_(options),
-      extractor_(std::make_unique<FeatureExtractor>(camera, options.odometry.extractor)),
-      tracker_(std::make_unique<Tracker>(camera, options.odometry)),
-      mapper_(std::make_unique<LocalMapper>(camera, options.odometry)),
-      relocalizer_(std::make_unique<Relocalizer>(camera, options.odometry)),
-      features_(std::make_unique<FrameFeatures>()),
-      tracked_(std::make_unique<TrackedFrame>()),
+      mapping_(options.output_delay_frames),
       snapshots_(std::make_unique<runtime::LatestSnapshot<LocalMap>>()),
-      trajectory_(options.output_delay_frames) {}
+      relocalizer_(std::make_unique<Relocalizer>(camera, options.odometry)) {
+  tracking_.tracker = std::make_unique<Tracker>(camera, options.odometry);
+  mapping_.mapper = std::make_unique<LocalMapper>(camera, options.odometry);
+}
 
 OdometrySystem::~OdometrySystem() = default;
-
-const FrameOutput& OdometrySystem::processImage(const RgbdImage& image) {
-  const auto start = std::chrono::steady_clock::now();
-  if (!extractor_->extract(image, *features_)) {
-    ++stats_.extraction_failures;
-    features_->clear();
-  }
-  const double extract_ms = millisecondsSince(start);
-  processFeatures(*features_, image.sequence, image.timestamp_s);
-  output_.extract_ms = extract_ms;
-  return output_;
-}
-
-const FrameOutput& OdometrySystem::processFeatures(const FrameFeatures& features, uint64_t sequence,
-                                                   double timestamp_s) {
-  trackFeatures(features, sequence, timestamp_s, nullptr, tracked_.get());
-  return mapFrame(*tracked_);
-}
 
 // ---------------------------------------------------------------------------------------------
 // Tracking side
@@ -51,7 +66,7 @@ void OdometrySystem::installNewestSnapshot() {
   uint64_t version = 0;
   const LocalMap* snapshot = snapshots_->acquireLatest(&version);
   // Older than what the tracker has: a map start installed a newer one directly (startMap).
-  if (snapshot != nullptr && snapshot->version > tracker_->localMap().version) tracker_->setLocalMap(*snapshot);
+  if (snapshot != nullptr && snapshot->version > tracking_.tracker->localMap().version) tracking_.tracker->setLocalMap(*snapshot);
 }
 
 bool OdometrySystem::canStartMap(const FrameFeatures& features) const {
@@ -70,14 +85,14 @@ void OdometrySystem::startMap(const FrameFeatures& features, uint64_t sequence, 
                               const Eigen::Isometry3d& T_world_cam, MapperFence* fence, TrackedFrame* out) {
   if (fence != nullptr) fence->waitForMapper();
   KeyframeRequest& request = out->request;
-  tracker_->fillNewMapRequest(features, sequence, timestamp_s, T_world_cam, &request);
-  const InsertResult inserted = mapper_->insertKeyframe(request);
-  tracker_->setLocalMap(mapper_->localMap());
-  tracker_->resetAt(features, T_world_cam);
+  tracking_.tracker->fillNewMapRequest(features, sequence, timestamp_s, T_world_cam, &request);
+  const InsertResult inserted = mapping_.mapper->insertKeyframe(request);
+  tracking_.tracker->setLocalMap(mapping_.mapper->localMap());
+  tracking_.tracker->resetAt(features, T_world_cam);
   relocalizer_->addKeyframe(inserted.keyframe_id, T_world_cam, features);
-  map_started_ = true;
-  lost_ = false;
-  lost_streak_ = 0;
+  tracking_.map_started = true;
+  tracking_.lost = false;
+  tracking_.lost_streak = 0;
   FrameOutput& o = out->output;
   o.state = TrackingState::kOk;
   o.has_pose = true;
@@ -95,9 +110,9 @@ void OdometrySystem::tryRelocalize(const FrameFeatures& features, MapperFence* f
   Eigen::Isometry3d T_world_cam;
   const RelocResult r = relocalizer_->relocalize(features, &T_world_cam);
   if (!r.success) return;
-  tracker_->resetAt(features, T_world_cam);
-  lost_ = false;
-  lost_streak_ = 0;
+  tracking_.tracker->resetAt(features, T_world_cam);
+  tracking_.lost = false;
+  tracking_.lost_streak = 0;
   FrameOutput& o = out->output;
   o.state = TrackingState::kOk;
   o.has_pose = true;
@@ -109,7 +124,7 @@ void OdometrySystem::trackFeatures(const FrameFeatures& features, uint64_t seque
                                    MapperFence* fence, TrackedFrame* out) {
   const auto start = std::chrono::steady_clock::now();
   // Read before installing: a request reported done has its snapshot published already.
-  const bool request_pending = keyframe_requests_done_.load(std::memory_order_acquire) < keyframe_requests_;
+  const bool request_pending = keyframe_requests_done_.load(std::memory_order_acquire) < tracking_.keyframe_requests;
   installNewestSnapshot();
   FrameOutput& o = out->output;
   o = FrameOutput{};
@@ -120,34 +135,34 @@ void OdometrySystem::trackFeatures(const FrameFeatures& features, uint64_t seque
   out->map_keyframe = false;
   out->relocalization_attempted = false;
 
-  if (!map_started_) {
-    if (canStartMap(features)) startMap(features, sequence, timestamp_s, T_world_last_good_, fence, out);
-  } else if (lost_) {
+  if (!tracking_.map_started) {
+    if (canStartMap(features)) startMap(features, sequence, timestamp_s, tracking_.T_world_last_good, fence, out);
+  } else if (tracking_.lost) {
     tryRelocalize(features, fence, out);
-    if (!o.has_pose && ++lost_streak_ >= options_.odometry.relocalizer.max_lost_frames_before_new_map &&
+    if (!o.has_pose && ++tracking_.lost_streak >= options_.odometry.relocalizer.max_lost_frames_before_new_map &&
         canStartMap(features)) {
       // Relocalization keeps failing: a new map segment from here, at the last known pose.
-      startMap(features, sequence, timestamp_s, T_world_last_good_, fence, out);
+      startMap(features, sequence, timestamp_s, tracking_.T_world_last_good, fence, out);
     }
   } else {
-    o.track = tracker_->track(features, sequence, timestamp_s, request_pending ? nullptr : &out->request);
+    o.track = tracking_.tracker->track(features, sequence, timestamp_s, request_pending ? nullptr : &out->request);
     o.state = o.track.state;
     if (o.state == TrackingState::kLost) {
-      lost_ = true;
-      lost_streak_ = 1;
+      tracking_.lost = true;
+      tracking_.lost_streak = 1;
       tryRelocalize(features, fence, out);
     } else {
       o.has_pose = true;
       o.T_world_cam = o.track.T_world_cam;
-      const LocalMap& snapshot = tracker_->localMap();
+      const LocalMap& snapshot = tracking_.tracker->localMap();
       out->reference_id = snapshot.reference_keyframe_id;
       out->T_ref_cam = snapshot.T_world_reference.inverse() * o.T_world_cam;
       out->map_keyframe = o.track.keyframe_requested;
-      keyframe_requests_ += out->map_keyframe;
+      tracking_.keyframe_requests += out->map_keyframe;
     }
   }
-  if (!o.has_pose && map_started_) o.state = TrackingState::kLost;
-  if (o.has_pose) T_world_last_good_ = o.T_world_cam;
+  if (!o.has_pose && tracking_.map_started) o.state = TrackingState::kLost;
+  if (o.has_pose) tracking_.T_world_last_good = o.T_world_cam;
   o.track_ms = millisecondsSince(start);
 }
 
@@ -155,63 +170,63 @@ void OdometrySystem::trackFeatures(const FrameFeatures& features, uint64_t seque
 // Mapping side
 
 void OdometrySystem::insertKeyframe(const KeyframeRequest& request) {
-  const InsertResult inserted = mapper_->insertKeyframe(request);
-  output_.insert = inserted;
+  const InsertResult inserted = mapping_.mapper->insertKeyframe(request);
+  mapping_.output.insert = inserted;
   if (!inserted.inserted) return;
-  const LocalMap& snapshot = mapper_->localMap();
+  const LocalMap& snapshot = mapping_.mapper->localMap();
   // Copied into the channel's preallocated buffer; the tracker installs it before its next frame.
   snapshots_->writeBuffer() = snapshot;
   snapshots_->publish(snapshot.version);
   relocalizer_->addKeyframe(inserted.keyframe_id, request.T_world_cam, request.features);
   // Stored keyframes follow local BA's refinements while they are in the map.
   for (const LocalMapKeyframe& kf : snapshot.keyframes) relocalizer_->updatePose(kf.id, kf.T_world_cam);
-  output_.keyframe = true;
+  mapping_.output.keyframe = true;
 }
 
 const FrameOutput& OdometrySystem::mapFrame(const TrackedFrame& tracked) {
-  output_ = tracked.output;
+  mapping_.output = tracked.output;
   uint32_t reference_id = tracked.reference_id;
   Eigen::Isometry3d T_ref_cam = tracked.T_ref_cam;
   if (tracked.map_keyframe) {
     const auto map_start = std::chrono::steady_clock::now();
     insertKeyframe(tracked.request);
     keyframe_requests_done_.fetch_add(1, std::memory_order_release);
-    output_.map_ms = millisecondsSince(map_start);
-    if (output_.keyframe) {
-      reference_id = output_.insert.keyframe_id;
+    mapping_.output.map_ms = millisecondsSince(map_start);
+    if (mapping_.output.keyframe) {
+      reference_id = mapping_.output.insert.keyframe_id;
       T_ref_cam = Eigen::Isometry3d::Identity();
     }
   }
   recordOutput(tracked);
-  trajectory_.push(output_.sequence, output_.timestamp_s, output_.has_pose, output_.T_world_cam, reference_id,
+  mapping_.trajectory.push(mapping_.output.sequence, mapping_.output.timestamp_s, mapping_.output.has_pose, mapping_.output.T_world_cam, reference_id,
                    T_ref_cam);
-  return output_;
+  return mapping_.output;
 }
 
 const FrameOutput& OdometrySystem::mapDroppedFrame(uint64_t sequence, double timestamp_s) {
-  output_ = FrameOutput{};
-  output_.sequence = sequence;
-  output_.timestamp_s = timestamp_s;
-  output_.dropped = true;
-  trajectory_.pushDropped(sequence, timestamp_s);
-  return output_;
+  mapping_.output = FrameOutput{};
+  mapping_.output.sequence = sequence;
+  mapping_.output.timestamp_s = timestamp_s;
+  mapping_.output.dropped = true;
+  mapping_.trajectory.pushDropped(sequence, timestamp_s);
+  return mapping_.output;
 }
 
 void OdometrySystem::recordOutput(const TrackedFrame& tracked) {
-  ++stats_.frames;
-  stats_.relocalization_attempts += tracked.relocalization_attempted;
-  stats_.relocalizations += output_.relocalized;
-  stats_.segments += output_.new_map;
-  stats_.keyframes += output_.keyframe;
-  if (output_.track.used_motion_fallback) ++stats_.frames_motion_fallback;
-  if (output_.state == TrackingState::kNotInitialized && !output_.has_pose) {
-    ++stats_.frames_not_initialized;
-  } else if (!output_.has_pose) {
-    ++stats_.frames_lost;
-  } else if (output_.state == TrackingState::kWeak) {
-    ++stats_.frames_weak;
+  ++mapping_.stats.frames;
+  mapping_.stats.relocalization_attempts += tracked.relocalization_attempted;
+  mapping_.stats.relocalizations += mapping_.output.relocalized;
+  mapping_.stats.segments += mapping_.output.new_map;
+  mapping_.stats.keyframes += mapping_.output.keyframe;
+  if (mapping_.output.track.used_motion_fallback) ++mapping_.stats.frames_motion_fallback;
+  if (mapping_.output.state == TrackingState::kNotInitialized && !mapping_.output.has_pose) {
+    ++mapping_.stats.frames_not_initialized;
+  } else if (!mapping_.output.has_pose) {
+    ++mapping_.stats.frames_lost;
+  } else if (mapping_.output.state == TrackingState::kWeak) {
+    ++mapping_.stats.frames_weak;
   } else {
-    ++stats_.frames_ok;
+    ++mapping_.stats.frames_ok;
   }
 }
 

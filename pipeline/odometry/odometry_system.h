@@ -1,48 +1,42 @@
 #pragma once
-// OdometrySystem: the whole odometry, single-threaded and deterministic, as separable steps:
+// OdometrySystem: the odometry as two sides that run on the track and map stages of the one runner
+// (pipeline/run/odometry_run.h); extraction is the extract stage's own FeatureExtractor.
 //
-//   extract (FeatureExtractor) -> Tracker::track (reads its LocalMap snapshot)
-//     -> KeyframeRequest -> LocalMapper::insertKeyframe (owns the Map, local BA, culling)
-//     -> new LocalMap snapshot -> Tracker::setLocalMap
+//   trackFeatures (tracking side): installs the newest LocalMap snapshot the mapping side published
+//     (runtime::LatestSnapshot, newer versions only), tracks, and fills a TrackedFrame (pose,
+//     reference keyframe, keyframe request) that travels with the frame to
+//   mapFrame (mapping side, frame order): LocalMapper::insertKeyframe + local BA for a request,
+//     publishes the new snapshot, updates the relocalizer, statistics and the output trajectory.
 //   lost -> Relocalizer (stored keyframes) -> Tracker::resetAt; still lost after M frames -> a new
 //   map segment starts from the current frame at the last known pose (the trajectory continues).
 //
-// processImage() runs every step for one frame; processFeatures() starts after extraction (for a
-// runtime that extracts on another thread). processFeatures() is trackFeatures() then mapFrame(),
-// and a staged runtime calls those two on separate threads (tracking and mapping stages):
-//
-//   trackFeatures (tracking thread): installs the newest LocalMap snapshot the mapping side
-//     published (runtime::LatestSnapshot, newer versions only), tracks, and fills a TrackedFrame
-//     (pose, reference keyframe, keyframe request) that travels with the frame to
-//   mapFrame (mapping thread, frame order): LocalMapper::insertKeyframe + local BA for a request,
-//     publishes the new snapshot, updates the relocalizer, statistics and the output trajectory.
-//
-// Rare events need the mapper and relocalizer synchronously: starting a map (segment) and
-// relocalizing. Before them trackFeatures() calls MapperFence::waitForMapper(), which returns once
-// every earlier frame has been through mapFrame() (the mapping thread is then idle until this frame
-// reaches it), so the two threads never touch the mapper or relocalizer at the same time. In
-// lock-step (and in processFeatures) the fence never waits and every frame sees exactly the
-// single-threaded map; threaded runs track against the newest snapshot published so far, and while
-// a keyframe request is still with the mapper the tracker makes no keyframe decision (ORB-SLAM's
-// "local mapping busy"): it would judge against a map that lacks the pending keyframe and ask for
-// near-duplicates. In lock-step a request is always done before the next frame, so this never
-// applies there.
+// Each side's state is its own struct (TrackingSide, MappingSide) and nothing here hands one side's
+// state to the other's thread. What they share: the snapshot channel (mapping -> tracking), a
+// counter of finished keyframe requests, and the relocalizer, which only the rare synchronous
+// events touch from the tracking side: starting a map (segment) and relocalizing wait on the
+// MapperFence (pipeline/odometry/mapper_fence.h) until every earlier frame has been mapped, so the
+// two threads never use the mapper or the relocalizer at the same time. In lock-step the fence
+// never waits and every frame sees exactly the single-threaded map; threaded runs track against
+// the newest snapshot published so far, and while a keyframe request is still with the mapper the
+// tracker makes no keyframe decision (ORB-SLAM's "local mapping busy"): it would judge against a
+// map that lacks the pending keyframe and ask for near-duplicates.
 // Output: finished frames (reference-keyframe relative, see OdometryTrajectory) and retired
-// keyframes with their covariance, drained by the caller on the mapping side.
+// keyframes with their covariance, drained on the mapping side.
 #include <atomic>
 #include <cstdint>
 #include <memory>
 
 #include "sensor/camera.h"
-#include "pipeline/frontend/feature_extractor.h"
+#include "pipeline/frontend/frame_features.h"
 #include "pipeline/odometry/keyframe_request.h"
 #include "pipeline/odometry/local_mapper.h"
+#include "pipeline/odometry/mapper_fence.h"
 #include "pipeline/odometry/odometry_options.h"
 #include "pipeline/odometry/odometry_stats.h"
 #include "pipeline/odometry/odometry_trajectory.h"
 #include "pipeline/odometry/relocalizer.h"
-#include "sensor/rgbd_image.h"
 #include "pipeline/odometry/tracker.h"
+#include "platform/status.h"
 #include "runtime/latest_snapshot.h"
 
 namespace plumb {
@@ -73,65 +67,77 @@ struct TrackedFrame {
   KeyframeRequest request;
 };
 
-// How the tracking side waits for the mapping side in a threaded run (see the header comment).
-class MapperFence {
- public:
-  virtual ~MapperFence() = default;
-  // Returns once every frame tracked before the current one has been through mapFrame().
-  virtual void waitForMapper() = 0;
-};
-
 struct SystemOptions {
   OdometryOptions odometry;
   // Output delay of the reference-keyframe-relative trajectory (frames); 0 = poses as tracked.
   int output_delay_frames = 60;
 };
 
+// Every option of the system in one place; validated once, where the system is built.
+Status validate(const SystemOptions& options);
+
 class OdometrySystem {
  public:
-  OdometrySystem(const PinholeCamera& camera, const SystemOptions& options);
+  // Refuses options that validate() rejects and a camera that cannot be used, with a message.
+  static Status create(const PinholeCamera& camera, const SystemOptions& options,
+                       std::unique_ptr<OdometrySystem>* out);
   ~OdometrySystem();
   OdometrySystem(const OdometrySystem&) = delete;
   OdometrySystem& operator=(const OdometrySystem&) = delete;
 
-  const FrameOutput& processImage(const RgbdImage& image);
-  const FrameOutput& processFeatures(const FrameFeatures& features, uint64_t sequence, double timestamp_s);
+  const PinholeCamera& camera() const { return camera_; }
+  const SystemOptions& options() const { return options_; }
 
-  // The two halves of processFeatures() (header comment). fence may be nullptr (never waits).
+  // Tracking side. fence may be nullptr (never waits).
   void trackFeatures(const FrameFeatures& features, uint64_t sequence, double timestamp_s, MapperFence* fence,
                      TrackedFrame* out);
-  const FrameOutput& mapFrame(const TrackedFrame& tracked);
-  // Mapping side: a frame the runtime dropped (real-time replay, no free slot) takes its place in
-  // the output trajectory (FinishedFrame::dropped); call in frame order between mapFrame() calls.
-  const FrameOutput& mapDroppedFrame(uint64_t sequence, double timestamp_s);
 
   // Mapping side (mapFrame's thread) from here on.
+  const FrameOutput& mapFrame(const TrackedFrame& tracked);
+  // A frame the runtime dropped (real-time replay, no free slot) takes its place in the output
+  // trajectory (FinishedFrame::dropped); call in frame order between mapFrame() calls.
+  const FrameOutput& mapDroppedFrame(uint64_t sequence, double timestamp_s);
   // Frames whose output pose is final, oldest first; fn(const FinishedFrame&).
   template <typename Fn>
-  void drainFinishedFrames(Fn fn) { trajectory_.popReady(mapper_->localMap(), fn); }
+  void drainFinishedFrames(Fn fn) { mapping_.trajectory.popReady(mapping_.mapper->localMap(), fn); }
   // Retired keyframes (final pose + covariance); fn(const RetiredKeyframe&).
   template <typename Fn>
   void drainRetiredKeyframes(Fn fn) {
-    for (const auto& kf : mapper_->retired()) fn(kf);
-    mapper_->clearRetired();
+    for (const auto& kf : mapping_.mapper->retired()) fn(kf);
+    mapping_.mapper->clearRetired();
   }
   // End of the run: every pending frame is finished and every keyframe retired.
   template <typename FrameFn, typename KeyframeFn>
   void finish(FrameFn frame_fn, KeyframeFn keyframe_fn) {
-    trajectory_.flushAll(mapper_->localMap(), frame_fn);
-    mapper_->retireAll();
+    mapping_.trajectory.flushAll(mapping_.mapper->localMap(), frame_fn);
+    mapping_.mapper->retireAll();
     drainRetiredKeyframes(keyframe_fn);
   }
-
-  const OdometryStats& stats() const { return stats_; }
-  const MapperStats& mapperStats() const { return mapper_->stats(); }
-  MapCounts mapCounts() const { return mapper_->map().counts(); }
-  const FeatureExtractor& extractor() const { return *extractor_; }
-  Tracker& tracker() { return *tracker_; }
-  LocalMapper& mapper() { return *mapper_; }
-  Relocalizer& relocalizer() { return *relocalizer_; }
+  const OdometryStats& stats() const { return mapping_.stats; }
+  const MapperStats& mapperStats() const { return mapping_.mapper->stats(); }
+  MapCounts mapCounts() const { return mapping_.mapper->map().counts(); }
 
  private:
+  OdometrySystem(const PinholeCamera& camera, const SystemOptions& options);
+
+  // The tracking thread's state.
+  struct TrackingSide {
+    std::unique_ptr<Tracker> tracker;
+    bool map_started = false;
+    bool lost = false;
+    int lost_streak = 0;
+    Eigen::Isometry3d T_world_last_good = Eigen::Isometry3d::Identity();
+    uint64_t keyframe_requests = 0;  // handed to mapFrame()
+  };
+  // The mapping thread's state.
+  struct MappingSide {
+    std::unique_ptr<LocalMapper> mapper;
+    OdometryTrajectory trajectory;
+    OdometryStats stats;
+    FrameOutput output;
+    explicit MappingSide(int delay_frames) : trajectory(delay_frames) {}
+  };
+
   // Tracking side.
   void installNewestSnapshot();
   bool canStartMap(const FrameFeatures& features) const;
@@ -142,27 +148,16 @@ class OdometrySystem {
   void insertKeyframe(const KeyframeRequest& request);
   void recordOutput(const TrackedFrame& tracked);
 
-  PinholeCamera camera_;
-  SystemOptions options_;
-  std::unique_ptr<FeatureExtractor> extractor_;
-  std::unique_ptr<Tracker> tracker_;
-  std::unique_ptr<LocalMapper> mapper_;
-  std::unique_ptr<Relocalizer> relocalizer_;
-  std::unique_ptr<FrameFeatures> features_;
-  std::unique_ptr<TrackedFrame> tracked_;  // processFeatures()'s hand-over
-  // Mapping -> tracking: LocalMap snapshots after each inserted keyframe (triple buffer).
+  const PinholeCamera camera_;
+  const SystemOptions options_;
+  TrackingSide tracking_;
+  MappingSide mapping_;
+  // Shared, see the header comment: snapshots mapping -> tracking (triple buffer), finished
+  // keyframe requests (release after the snapshot is published), and the relocalizer (written by
+  // the mapping side, used by the tracking side only behind the fence).
   std::unique_ptr<runtime::LatestSnapshot<LocalMap>> snapshots_;
-  // Tracking side state.
-  bool map_started_ = false;
-  bool lost_ = false;
-  int lost_streak_ = 0;
-  Eigen::Isometry3d T_world_last_good_ = Eigen::Isometry3d::Identity();
-  uint64_t keyframe_requests_ = 0;  // handed to mapFrame()
-  // Mapping side state.
-  std::atomic<uint64_t> keyframe_requests_done_{0};  // after the snapshot is published (release)
-  OdometryTrajectory trajectory_;
-  OdometryStats stats_;
-  FrameOutput output_;
+  std::atomic<uint64_t> keyframe_requests_done_{0};
+  std::unique_ptr<Relocalizer> relocalizer_;
 };
 
 }  // namespace plumb

@@ -4,7 +4,7 @@
 
 #include <filesystem>
 
-#include "drivers/common/open_source.h"
+#include "drivers/open/open_source.h"
 #include "drivers/dataset/camera_presets.h"
 #include "drivers/dataset/tum_dataset.h"
 #include "drivers/openni2/openni2_source.h"

@@ -8,7 +8,7 @@
 #include "drivers/fault/fault_injecting_source.h"
 #include "drivers/fault/resilient_source.h"
 #include "drivers/synth/synthetic_scene.h"
-#include "pipeline/odometry/odometry_system.h"
+#include "tests/support/odometry_run.h"
 
 namespace plumb {
 namespace {
@@ -35,33 +35,31 @@ TEST(FaultPipeline, TrajectoryContinuesAfterReconnection) {
 
   SystemOptions options;
   options.output_delay_frames = 0;  // poses as tracked, frame by frame
-  OdometrySystem system(camera, options);
-  RgbdImage image;
+  test::RunSettings settings;
+  settings.keep_outputs = true;
+  settings.max_frames = 200;  // a guard: the source ends by itself
+  const test::OdometryRun run = test::runOdometry(source, options, settings);
+  ASSERT_TRUE(run.status.ok()) << run.status.message();
   bool have_first = false;
   Eigen::Isometry3d T_first_est = Eigen::Isometry3d::Identity();
   uint64_t first_sequence = 0;
   int frames_after_reconnect = 0, posed_after_reconnect = 0;
   TrackingState last_state = TrackingState::kNotInitialized;
   double worst_error_after_reconnect_m = 0, last_error_m = 0;
-  for (int guard = 0; guard < 200; ++guard) {
-    const SourceResult r = source.next(image);
-    if (r == SourceResult::kEndOfStream) break;
-    if (r == SourceResult::kNoFrame) continue;
-    ASSERT_EQ(r, SourceResult::kFrame) << source.lastError().message();
-    const FrameOutput& out = system.processImage(image);
+  for (const FrameOutput& out : run.outputs) {
     last_state = out.state;
-    if (image.sequence >= 44) ++frames_after_reconnect;
+    if (out.sequence >= 44) ++frames_after_reconnect;
     if (!out.has_pose) continue;
     if (!have_first) {
       have_first = true;
       T_first_est = out.T_world_cam;
-      first_sequence = image.sequence;
+      first_sequence = out.sequence;
       continue;
     }
-    if (image.sequence < 44) continue;
+    if (out.sequence < 44) continue;
     ++posed_after_reconnect;
     // Motion since the first posed frame, estimated vs exact.
-    const int i0 = static_cast<int>(first_sequence), i = static_cast<int>(image.sequence);
+    const int i0 = static_cast<int>(first_sequence), i = static_cast<int>(out.sequence);
     const Eigen::Isometry3d gt = scene.T_world_cam(i0).inverse() * scene.T_world_cam(i);
     const Eigen::Isometry3d est = T_first_est.inverse() * out.T_world_cam;
     last_error_m = (gt.translation() - est.translation()).norm();

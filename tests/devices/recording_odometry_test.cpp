@@ -4,10 +4,10 @@
 
 #include <filesystem>
 
-#include "drivers/common/open_source.h"
+#include "drivers/open/open_source.h"
 #include "drivers/recording/recording_writer.h"
-#include "pipeline/odometry/odometry_system.h"
 #include "tests/devices/device_test_util.h"
+#include "tests/support/odometry_run.h"
 
 namespace plumb {
 namespace {
@@ -15,13 +15,13 @@ namespace {
 std::vector<Eigen::Isometry3d> track(FrameSource& source) {
   SystemOptions options;
   options.output_delay_frames = 0;
-  OdometrySystem system(source.camera(), options);
+  test::RunSettings settings;
+  settings.keep_outputs = true;
+  const test::OdometryRun run = test::runOdometry(source, options, settings);
+  EXPECT_TRUE(run.status.ok()) << run.status.message();
   std::vector<Eigen::Isometry3d> poses;
-  RgbdImage image;
-  while (source.next(image) == SourceResult::kFrame) {
-    const FrameOutput& out = system.processImage(image);
+  for (const FrameOutput& out : run.outputs)
     poses.push_back(out.has_pose ? out.T_world_cam : Eigen::Isometry3d(Eigen::Matrix4d::Zero()));
-  }
   return poses;
 }
 

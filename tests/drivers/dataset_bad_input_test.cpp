@@ -5,7 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "dataset_test_support.h"
-#include "drivers/common/open_source.h"
+#include "drivers/open/open_source.h"
 #include "drivers/dataset/tum_dataset.h"
 
 namespace plumb {

@@ -1,7 +1,7 @@
 // openFrameSource: the specification strings of the command line.
 #include <gtest/gtest.h>
 
-#include "drivers/common/open_source.h"
+#include "drivers/open/open_source.h"
 
 namespace plumb {
 namespace {

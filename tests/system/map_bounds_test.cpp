@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "pipeline/odometry/map.h"
-#include "tests/system/odometry_test_util.h"
+#include "tests/support/odometry_run.h"
 
 namespace plumb::test {
 namespace {

@@ -1,45 +1,81 @@
-// Loss and recovery: blank frames in the middle of a sequence lose tracking; the system marks
-// them lost, relocalizes against its stored keyframes when real frames return, and goes on.
+// Loss and recovery, in lock-step (deterministic) and through the THREADED pipeline (fast), where
+// the track stage uses the mapper and relocalizer itself after MapperFence::waitForMapper()
+// (pipeline/odometry/mapper_fence.h): blank frames in the middle of a sequence lose tracking; the
+// system marks them lost, relocalizes against its stored keyframes when real frames return, and
+// goes on; frames of another scene start a new map segment. Every run must finish (no dead lock)
+// and account for every frame.
 #include <gtest/gtest.h>
 
-#include "tests/system/odometry_test_util.h"
+#include "tests/support/odometry_run.h"
 
 namespace plumb::test {
 namespace {
 
-TEST(OdometryRecovery, RelocalizesAfterBlankFramesAndMarksThemLost) {
+// Frames of scene `a`, blank frames (sensor covered) in [blank_begin, blank_end), then frames of
+// scene `b` (which may be `a` continued).
+class ScriptedSource final : public FrameSource {
+ public:
+  ScriptedSource(const SyntheticScene& a, const SyntheticScene* b, int a_frames, int total, int blank_begin,
+                 int blank_end)
+      : a_(a), b_(b), a_frames_(a_frames), total_(total), blank_begin_(blank_begin), blank_end_(blank_end) {}
+
+  SourceResult next(RgbdImage& out) override {
+    if (next_ >= total_) return SourceResult::kEndOfStream;
+    const int i = next_++;
+    const bool from_a = b_ == nullptr || i < a_frames_;
+    status_ = from_a ? a_.render(i, out) : b_->render(i - a_frames_, out);
+    if (!status_.ok()) return SourceResult::kError;
+    out.sequence = uint64_t(i);
+    out.timestamp_s = 1000.0 + i / 30.0;
+    if (i >= blank_begin_ && i < blank_end_) {
+      out.bgr.setTo(cv::Scalar::all(0));
+      out.depth_raw.setTo(cv::Scalar::all(0));
+    }
+    return SourceResult::kFrame;
+  }
+  const PinholeCamera& camera() const override { return a_.camera(); }
+  std::string describe() const override { return "scripted synthetic"; }
+  const Status& lastError() const override { return status_; }
+
+ private:
+  const SyntheticScene& a_;
+  const SyntheticScene* b_;
+  int a_frames_, total_, blank_begin_, blank_end_;
+  int next_ = 0;
+  Status status_;
+};
+
+class OdometryRecovery : public ::testing::TestWithParam<runtime::RunMode> {
+ protected:
+  OdometryRun run(FrameSource& source, const SystemOptions& options) {
+    RunSettings settings;
+    settings.mode = GetParam();
+    OdometryRun r = runOdometry(source, options, settings);
+    EXPECT_TRUE(r.status.ok()) << r.status.message();
+    return r;
+  }
+  // Threaded runs track against the newest published map, not exactly the lock-step one.
+  double ateBound() const { return GetParam() == runtime::RunMode::kDeterministic ? 0.02 : 0.03; }
+};
+
+TEST_P(OdometryRecovery, RelocalizesAfterBlankFramesAndMarksThemLost) {
   constexpr int kBefore = 60, kBlank = 6, kTotal = 110;
   std::unique_ptr<SyntheticScene> scene;
   ASSERT_TRUE(SyntheticScene::create(noisySynth("textured", kTotal), &scene).ok());
-  auto system = std::make_unique<OdometrySystem>(scene->camera(), systemOptions(true));
-  OdometryRun run;
-  RgbdImage image;
-  for (int i = 0; i < kTotal; ++i) {
-    ASSERT_TRUE(scene->render(i, image).ok());
-    image.sequence = uint64_t(i);
-    if (i >= kBefore && i < kBefore + kBlank) {  // sensor covered: no image, no depth
-      image.bgr.setTo(cv::Scalar::all(0));
-      image.depth_raw.setTo(cv::Scalar::all(0));
-    }
-    system->processImage(image);
-    collect(*system, &run);
-  }
-  system->finish([&run](const FinishedFrame& f) {
-    run.trajectory.push_back(StampedPose{f.timestamp_s, f.T_world_cam, f.valid});
-  }, [](const RetiredKeyframe&) {});
-  ASSERT_EQ(run.trajectory.size(), std::size_t(kTotal));
-  for (int i = kBefore; i < kBefore + kBlank; ++i) EXPECT_FALSE(run.trajectory[i].valid) << "frame " << i;
-  for (int i = kBefore + kBlank; i < kTotal; ++i) EXPECT_TRUE(run.trajectory[i].valid) << "frame " << i;
-  const OdometryStats& stats = system->stats();
-  EXPECT_EQ(stats.frames_lost, uint64_t(kBlank));
-  EXPECT_GE(stats.relocalizations, 1u);
-  EXPECT_EQ(stats.segments, 1u);  // relocalized: no new map was needed
+  ScriptedSource source(*scene, nullptr, kTotal, kTotal, kBefore, kBefore + kBlank);
+  const OdometryRun r = run(source, systemOptions(true));
+  ASSERT_EQ(r.trajectory.size(), std::size_t(kTotal));
+  for (int i = kBefore; i < kBefore + kBlank; ++i) EXPECT_FALSE(r.trajectory[i].valid) << "frame " << i;
+  for (int i = kBefore + kBlank; i < kTotal; ++i) EXPECT_TRUE(r.trajectory[i].valid) << "frame " << i;
+  EXPECT_EQ(r.stats.frames_lost, uint64_t(kBlank));
+  EXPECT_GE(r.stats.relocalizations, 1u);
+  EXPECT_EQ(r.stats.segments, 1u);  // relocalized: no new map was needed
   // The relocalized poses continue the same world frame.
-  EXPECT_LT(ateRmse(groundTruth(*scene, kTotal), run.trajectory), 0.02);
+  EXPECT_LT(ateRmse(groundTruth(*scene, kTotal), r.trajectory), ateBound());
 }
 
-TEST(OdometryRecovery, NewMapSegmentWhenRelocalizationKeepsFailing) {
-  // Frames of a different scene (another seed) after the blank: no stored keyframe matches them,
+TEST_P(OdometryRecovery, NewMapSegmentWhenRelocalizationKeepsFailing) {
+  // Frames of a different scene (another seed) after the first: no stored keyframe matches them,
   // so after M lost frames a new map starts and the trajectory continues.
   constexpr int kFirst = 40, kSecond = 40;
   std::unique_ptr<SyntheticScene> a, b;
@@ -47,22 +83,20 @@ TEST(OdometryRecovery, NewMapSegmentWhenRelocalizationKeepsFailing) {
   SynthOptions other = noisySynth("low_texture", kSecond);
   other.seed = 7;
   ASSERT_TRUE(SyntheticScene::create(other, &b).ok());
-  SystemOptions options = systemOptions(true);
-  auto system = std::make_unique<OdometrySystem>(a->camera(), options);
-  RgbdImage image;
-  OdometryRun run;
-  for (int i = 0; i < kFirst + kSecond; ++i) {
-    ASSERT_TRUE((i < kFirst ? a->render(i, image) : b->render(i - kFirst, image)).ok());
-    image.timestamp_s = 1000.0 + i / 30.0;
-    image.sequence = uint64_t(i);
-    system->processImage(image);
-    collect(*system, &run);
-  }
-  const OdometryStats& stats = system->stats();
-  EXPECT_EQ(stats.segments, 2u);
-  EXPECT_LE(stats.frames_lost, uint64_t(options.odometry.relocalizer.max_lost_frames_before_new_map));
-  EXPECT_GT(stats.frames_ok, uint64_t(kFirst + kSecond - 15));
+  ScriptedSource source(*a, b.get(), kFirst, kFirst + kSecond, 0, 0);
+  const SystemOptions options = systemOptions(true);
+  const OdometryRun r = run(source, options);
+  EXPECT_EQ(r.trajectory.size(), std::size_t(kFirst + kSecond));
+  EXPECT_EQ(r.stats.segments, 2u);
+  EXPECT_LE(r.stats.frames_lost, uint64_t(options.odometry.relocalizer.max_lost_frames_before_new_map));
+  EXPECT_GT(r.stats.frames_ok, uint64_t(kFirst + kSecond - 15));
 }
+
+INSTANTIATE_TEST_SUITE_P(Modes, OdometryRecovery,
+                         ::testing::Values(runtime::RunMode::kDeterministic, runtime::RunMode::kFast),
+                         [](const ::testing::TestParamInfo<runtime::RunMode>& info) {
+                           return std::string(runtime::runModeName(info.param));
+                         });
 
 }  // namespace
 }  // namespace plumb::test

@@ -1,7 +1,7 @@
 // End-to-end odometry on rendered synthetic scenes with Kinect-like noise and exact ground truth.
 #include <gtest/gtest.h>
 
-#include "tests/system/odometry_test_util.h"
+#include "tests/support/odometry_run.h"
 
 namespace plumb::test {
 namespace {

@@ -3,8 +3,8 @@
 
 #include <sys/stat.h>
 
-#include "drivers/common/open_source.h"
-#include "tests/system/odometry_test_util.h"
+#include "drivers/open/open_source.h"
+#include "tests/support/odometry_run.h"
 
 namespace plumb::test {
 namespace {

@@ -1,4 +1,4 @@
-// Real-time mode on a VirtualClock (tools/staged_run.h): the map stage made slow on one frame fills
+// Real-time mode on a VirtualClock (pipeline/run/odometry_run.h): the map stage made slow on one frame fills
 // every slot, exactly the frames that arrive meanwhile are dropped, and each dropped frame keeps its
 // place in the output trajectory as `# <timestamp> dropped`.
 #include <gtest/gtest.h>
@@ -9,9 +9,9 @@
 
 #include "drivers/synth/synthetic_scene.h"
 #include "drivers/trajectory/trajectory_io.h"
-#include "pipeline/odometry/odometry_system.h"
+#include "drivers/common/source_capture.h"
+#include "pipeline/run/odometry_run.h"
 #include "runtime/clock.h"
-#include "tools/staged_run.h"
 
 namespace plumb {
 namespace {
@@ -22,12 +22,30 @@ constexpr int64_t kSlowNs = 190'000'000;  // 5.7 frame periods at 30 Hz
 
 struct DropRun {
   std::vector<FinishedFrame> frames;  // the output trajectory, in output order
-  tools::StagedRunResult result;
+  OdometryRunResult result;
   std::vector<double> source_timestamps;
 };
 
-// Every stage takes no virtual time except the map stage on kSlowFrame (its on_output runs inside
-// the map stage's step, so advancing the clock there makes that step long).
+// Every stage takes no virtual time except the map stage on kSlowFrame (the sink runs inside the
+// map stage's step, so advancing the clock there makes that step long).
+class SlowOnceSink final : public OdometrySink {
+ public:
+  SlowOnceSink(runtime::VirtualClock& clock, DropRun* run) : clock_(clock), run_(run) {}
+  Status onFrame(const FrameOutput& out) override {
+    if (!out.dropped && processed_++ == kSlowFrame) clock_.advanceNs(kSlowNs);
+    return Status::Ok();
+  }
+  Status onFinishedFrame(const FinishedFrame& f) override {
+    run_->frames.push_back(f);
+    return Status::Ok();
+  }
+
+ private:
+  runtime::VirtualClock& clock_;
+  DropRun* run_;
+  int processed_ = 0;
+};
+
 void runWithSlowMapStage(DropRun* run) {
   SynthOptions synth;
   synth.preset = "textured";
@@ -36,22 +54,17 @@ void runWithSlowMapStage(DropRun* run) {
   ASSERT_TRUE(SyntheticSource::create(synth, &source).ok());
   for (int i = 0; i < kFrames; ++i) run->source_timestamps.push_back(source->scene().timestamp(i));
 
-  OdometrySystem system(source->camera(), SystemOptions{});
+  std::unique_ptr<OdometrySystem> system;
+  ASSERT_TRUE(OdometrySystem::create(source->camera(), SystemOptions{}, &system).ok());
   runtime::VirtualClock clock;
-  tools::StagedRunOptions options;
-  options.mode = runtime::RunMode::kRealtime;
-  options.clock = &clock;
-  options.slot_count = 4;
-  auto keep = [run](const FinishedFrame& f) { run->frames.push_back(f); };
-  int processed = 0;
-  const tools::FrameOutputFn on_output = [&](const FrameOutput& out) {
-    if (!out.dropped && processed++ == kSlowFrame) clock.advanceNs(kSlowNs);
-    system.drainFinishedFrames(keep);
-    return Status::Ok();
-  };
-  const Status status = tools::runStaged(*source, system, options, on_output, &run->result);
+  OdometryRunOptions options;
+  options.schedule.mode = runtime::RunMode::kRealtime;
+  options.schedule.clock = &clock;
+  options.schedule.slot_count = 4;
+  SlowOnceSink sink(clock, run);
+  SourceCapture capture(*source);
+  const Status status = runOdometry(capture, *system, sink, options, &run->result);
   ASSERT_TRUE(status.ok()) << status.message();
-  system.finish(keep, [](const RetiredKeyframe&) {});
 }
 
 TEST(StagedDrops, SlowMapStageDropsExactlyTheFramesThatFindNoSlot) {

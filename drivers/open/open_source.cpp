@@ -1,19 +1,16 @@
-#include "drivers/common/open_source.h"
+#include "drivers/open/open_source.h"
 
 #include <cctype>
 #include <fstream>
-#include <vector>
 
 #include "drivers/common/text_lines.h"
 #include "drivers/dataset/camera_presets.h"
 #include "drivers/dataset/tum_dataset.h"
-#include "drivers/recording/sensor_source_specs.h"
-#include "drivers/synth/synthetic_scene.h"
+#include "drivers/open/sensor_source_specs.h"
+#include "drivers/synth/synth_spec.h"
 
 namespace plumb {
 namespace {
-
-constexpr const char* kSynthPrefix = "synth:";
 
 // The benchmark's folder names say which sensor recorded them (rgbd_dataset_freiburg1_desk,
 // tum_fr1_rpy, living_room_traj0_frei_png, ...). Empty when the name does not tell.
@@ -33,36 +30,13 @@ std::string cameraPresetFromFolderName(const std::string& folder) {
   return "";
 }
 
-std::vector<std::string> splitColons(const std::string& text) {
-  std::vector<std::string> parts;
-  std::size_t start = 0;
-  for (std::size_t colon; (colon = text.find(':', start)) != std::string::npos; start = colon + 1)
-    parts.push_back(text.substr(start, colon - start));
-  parts.push_back(text.substr(start));
-  return parts;
-}
-
 // synth:PRESET[:SEED[:FRAMES]]; a synthetic scene always uses its own exact camera.
 Status openSynthetic(const std::string& spec, const std::string& camera_spec,
                      std::unique_ptr<FrameSource>* out) {
   if (!camera_spec.empty())
     return Status::Error(spec + ": a synthetic scene has its own camera; drop --camera " + camera_spec);
-  const std::vector<std::string> parts = splitColons(spec.substr(std::string(kSynthPrefix).size()));
-  if (parts.size() > 3 || parts[0].empty())
-    return Status::Error(spec + ": expected synth:PRESET[:SEED[:FRAMES]]");
-  SynthOptions options;
-  options.preset = parts[0];
-  if (parts.size() > 1) {
-    double seed = 0;
-    if (!parseDouble(parts[1], &seed) || seed < 0 || seed != static_cast<double>(static_cast<uint64_t>(seed)))
-      return Status::Error(spec + ": seed '" + parts[1] + "' is not a non-negative integer");
-    options.seed = static_cast<uint64_t>(seed);
-  }
-  if (parts.size() > 2 && (!parseInt(parts[2], &options.frames) || options.frames <= 0))
-    return Status::Error(spec + ": frames '" + parts[2] + "' is not a positive integer");
-  PLUMB_RETURN_IF_ERROR(validate(options).withContext(spec));
   std::unique_ptr<SyntheticSource> source;
-  PLUMB_RETURN_IF_ERROR(SyntheticSource::create(options, &source).withContext(spec));
+  PLUMB_RETURN_IF_ERROR(openSynthSpec(spec, false, &source));
   *out = std::move(source);
   return Status::Ok();
 }
@@ -72,7 +46,7 @@ Status openSynthetic(const std::string& spec, const std::string& camera_spec,
 Status openFrameSource(const std::string& spec, const std::string& camera_spec,
                        std::unique_ptr<FrameSource>* out) {
   if (spec.empty()) return Status::Error("empty source specification");
-  if (spec.rfind(kSynthPrefix, 0) == 0) return openSynthetic(spec, camera_spec, out);
+  if (isSynthSpec(spec)) return openSynthetic(spec, camera_spec, out);
   if (isSensorOrRecordingSpec(spec)) return openSensorOrRecordingSource(spec, camera_spec, out);
 
   // A dataset folder: an explicit camera wins, then the folder's camera.txt, then the sensor its

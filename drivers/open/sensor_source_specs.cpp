@@ -1,8 +1,8 @@
-#include "drivers/recording/sensor_source_specs.h"
+#include "drivers/open/sensor_source_specs.h"
 
 #include <cstdlib>
 
-#include "drivers/common/open_source.h"
+#include "drivers/open/open_source.h"
 #include "drivers/dataset/camera_presets.h"
 #include "drivers/fault/resilient_source.h"
 #include "drivers/openni2/openni2_source.h"

@@ -1,0 +1,47 @@
+#pragma once
+// MapperFence: how the tracking side waits for the mapping side in a threaded run.
+//
+// Starting a map (segment) and relocalizing need the mapper and the relocalizer synchronously, and
+// those belong to the mapping thread. Before either, the tracking thread calls waitForMapper(),
+// which returns once every frame tracked before the current one has been through mapFrame(): the
+// mapping thread is then idle until the current frame reaches it, so the two threads never touch
+// the mapper or the relocalizer at the same time. In lock-step (`threaded` false) that is always
+// already true and the fence never waits.
+#include <atomic>
+#include <cstdint>
+
+#include "runtime/doorbell.h"
+
+namespace plumb {
+
+class MapperFence {
+ public:
+  explicit MapperFence(bool threaded) : threaded_(threaded) {}
+
+  // Tracking thread: while frame number framesTracked() is being tracked.
+  void waitForMapper() {
+    if (!threaded_) return;
+    bell_.waitUntil([this] {
+      return failed_.load(std::memory_order_acquire) ||
+             frames_mapped_.load(std::memory_order_acquire) >= frames_tracked_;
+    });
+  }
+  // Tracking thread: after each frame.
+  void frameTracked() { ++frames_tracked_; }
+  // Mapping thread: after each frame, last (releases the mapper and relocalizer to a waiting
+  // tracker). `failed`: the mapping side stopped, so nobody is left to wait for.
+  void frameMapped(bool failed) {
+    if (failed) failed_.store(true, std::memory_order_release);
+    frames_mapped_.fetch_add(1, std::memory_order_release);
+    bell_.ring();
+  }
+
+ private:
+  const bool threaded_;
+  uint64_t frames_tracked_ = 0;  // tracking thread only
+  std::atomic<uint64_t> frames_mapped_{0};
+  std::atomic<bool> failed_{false};
+  runtime::Doorbell bell_;
+};
+
+}  // namespace plumb

@@ -1,0 +1,91 @@
+#pragma once
+// runOdometry(): THE frame loop of plumb. Every way of running the odometry (`plumb run`, `plumb
+// demo`, the system tests, the benchmarks, and every mode) goes through it:
+//
+//   capture (FrameCapture: a sensor or replay, prepared ahead)
+//     -> extract (FeatureExtractor, own per stage)          pipeline/run/odometry_stages.h
+//     -> track   (OdometrySystem tracking side)
+//     -> map     (OdometrySystem mapping side: keyframe, local BA, output trajectory -> sink)
+//          \__ LocalMap snapshots back to track through the system's snapshot channel __/
+//
+// The stages are runtime::Stage objects run by runtime::StageRunner. runtime::RunMode picks the
+// schedule, never the stages:
+//   deterministic: lock-step on the calling thread, one frame through all stages before the next
+//     is read. This IS the single-threaded program: every frame sees exactly the map the previous
+//     frames left, so the output is byte-identical run after run.
+//   fast / realtime: a thread per stage over SPSC rings; tracking uses the newest published map
+//     snapshot (timing dependent). Realtime paces the capture to the recorded timestamps and drops
+//     (and counts, and writes as `# <t> dropped`) a frame that finds no free slot.
+// The sink hears about every frame in frame order, on the map stage's thread. At the end (input
+// ended, max_frames, a stop request or an error) the system is finished: every pose held back for
+// refinement is delivered to the sink, so a stop or a read error keeps what was computed.
+#include <atomic>
+#include <cstdint>
+#include <vector>
+
+#include "pipeline/odometry/odometry_system.h"
+#include "platform/status.h"
+#include "runtime/run_options.h"
+#include "runtime/run_report.h"
+#include "runtime/trace_log.h"
+#include "sensor/frame_capture.h"
+
+namespace plumb {
+
+// Where a run's results go. Called on the map stage's thread, in frame order.
+class OdometrySink {
+ public:
+  virtual ~OdometrySink() = default;
+  // Every frame after mapping (FrameOutput::dropped for a frame real-time mode dropped).
+  virtual Status onFrame(const FrameOutput&) { return Status::Ok(); }
+  // A frame whose output pose is final (pipeline/odometry/odometry_trajectory.h), oldest first:
+  // exactly one per input frame, lost and dropped ones included.
+  virtual Status onFinishedFrame(const FinishedFrame& frame) = 0;
+  // A keyframe that left the map, with its final pose and covariance.
+  virtual Status onRetiredKeyframe(const RetiredKeyframe&) { return Status::Ok(); }
+};
+
+struct OdometryRunOptions {
+  // The schedule (mode, slots, thread priority, pinning, mlock, clock): runtime/run_options.h.
+  // Defaults for odometry: deterministic; 8 slots in the threaded modes (the front stages keep
+  // working through a long local BA, ~2 frame periods, instead of stalling on a full pool), while
+  // lock-step needs only one. end_to_end_stage and background_stages are set by runOdometry().
+  runtime::RunOptions schedule = defaultSchedule();
+  long max_frames = -1;          // > 0: stop after this many input frames (dropped ones count); -1: all
+  uint64_t warmup_frames = 30;   // heap allocations are counted from this frame on
+  bool keep_trace = false;       // copy the per-stage trace into the result (`--profile`)
+  // Set (e.g. by a SIGINT handler) to end the run after the frames already read: a clean end of
+  // input, so everything computed so far reaches the sink. nullptr: never.
+  const std::atomic<bool>* stop = nullptr;
+
+  static runtime::RunOptions defaultSchedule() {
+    runtime::RunOptions o;
+    o.mode = runtime::RunMode::kDeterministic;
+    o.slot_count = 8;
+    return o;
+  }
+};
+
+// Empty Status when usable; otherwise what is wrong (checked by runOdometry before any work).
+Status validate(const OdometryRunOptions& options);
+
+struct OdometryRunResult {
+  runtime::RunReport report;
+  std::vector<runtime::TraceTrack> trace;  // keep_trace
+  uint64_t frames = 0;          // frames tracked (not dropped)
+  uint64_t frames_dropped = 0;  // real-time mode: no free slot (each has its `# <t> dropped` line)
+  uint64_t extraction_failures = 0;  // frames whose image did not fit the camera (tracked featureless)
+  uint64_t drops_without_trajectory_line = 0;  // dropped beyond the drop log's capacity (34 s stall)
+  bool stopped = false;         // ended by options.stop
+  // Heap allocations (process-wide operator new calls) over the frames the map stage finished from
+  // warmup_frames on, until the capture found the input ended (thread exit allocates inside
+  // OpenCV's thread-local cleanup: shutdown, not per-frame cost). The first such frame is the
+  // baseline, so `allocation_frames` = frames counted after it.
+  uint64_t allocation_frames = 0;
+  uint64_t allocations_after_warmup = 0;
+};
+
+Status runOdometry(FrameCapture& capture, OdometrySystem& system, OdometrySink& sink,
+                   const OdometryRunOptions& options, OdometryRunResult* result);
+
+}  // namespace plumb

@@ -1,0 +1,123 @@
+#include "pipeline/run/odometry_stages.h"
+
+#include <chrono>
+
+#include "pipeline/run/odometry_run.h"
+#include "platform/allocation_counter.h"
+
+namespace plumb {
+
+// ---------------------------------------------------------------------------------------------
+// CaptureStage
+
+bool CaptureStage::ended() {
+  drops_.input_ended.store(true);
+  return false;
+}
+
+bool CaptureStage::peekNext(int64_t* t_recorded_ns) {
+  if (max_frames_ >= 0 && consumed_ >= max_frames_) return ended();
+  if (stop_ != nullptr && stop_->load(std::memory_order_relaxed)) {
+    stopped_ = true;
+    return ended();
+  }
+  return capture_.prepareNext(t_recorded_ns) || ended();
+}
+
+Status CaptureStage::read(OdometrySlot& slot, const runtime::FrameStamps& stamps) {
+  ++consumed_;
+  PLUMB_RETURN_IF_ERROR(capture_.take(slot.image));
+  slot.image.t_sensor_ns = stamps.t_sensor_ns;
+  slot.dropped_before = dropped_since_read_;
+  dropped_since_read_ = 0;
+  return Status::Ok();
+}
+
+void CaptureStage::skip() {
+  ++consumed_;
+  DroppedFrame dropped;
+  if (!capture_.drop(&dropped.sequence, &dropped.timestamp_s)) return;
+  if (drops_.ring.try_push(dropped)) {
+    ++dropped_since_read_;
+  } else {
+    ++drops_.not_logged;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// ExtractStage, TrackStage
+
+ExtractStage::ExtractStage(const OdometrySystem& system)
+    : extractor_(system.camera(), system.options().odometry.extractor) {}
+
+Status ExtractStage::process(OdometrySlot& slot, const runtime::FrameStamps&) {
+  const auto start = std::chrono::steady_clock::now();
+  // A frame that does not fit the camera is tracked featureless (and counted): it keeps its place.
+  if (!extractor_.extract(slot.image, *slot.features)) {
+    slot.features->clear();
+    ++failures_;
+  }
+  slot.extract_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return Status::Ok();
+}
+
+Status TrackStage::process(OdometrySlot& slot, const runtime::FrameStamps&) {
+  system_.trackFeatures(*slot.features, slot.image.sequence, slot.image.timestamp_s, &fence_, slot.tracked.get());
+  slot.tracked->output.extract_ms = slot.extract_ms;
+  fence_.frameTracked();
+  return Status::Ok();
+}
+
+// ---------------------------------------------------------------------------------------------
+// MapStage
+
+Status MapStage::deliver(const FrameOutput& out) {
+  Status status = sink_.onFrame(out);
+  system_.drainFinishedFrames([&](const FinishedFrame& f) {
+    if (status.ok()) status = sink_.onFinishedFrame(f);
+  });
+  system_.drainRetiredKeyframes([&](const RetiredKeyframe& kf) {
+    if (status.ok()) status = sink_.onRetiredKeyframe(kf);
+  });
+  return status;
+}
+
+Status MapStage::writeDrops(uint32_t count) {
+  Status status;
+  DroppedFrame dropped;
+  for (uint32_t i = 0; i < count && drops_.ring.try_pop(dropped); ++i) {
+    ++frames_dropped_;
+    const Status s = deliver(system_.mapDroppedFrame(dropped.sequence, dropped.timestamp_s));
+    if (status.ok()) status = s;
+  }
+  return status;
+}
+
+Status MapStage::process(OdometrySlot& slot, const runtime::FrameStamps& stamps) {
+  Status status = writeDrops(slot.dropped_before);
+  ++frames_;
+  const Status s = deliver(system_.mapFrame(*slot.tracked));
+  if (status.ok()) status = s;
+  // Process-wide count, read on this thread after each frame: from the first frame at or after
+  // warm-up to the last one finished before the input ended, every thread's allocations are
+  // included. The count is read before the flag, so a reading taken after a stage thread began
+  // to exit is never kept.
+  if (stamps.frame_index >= warmup_frames_) {
+    const uint64_t now = allocationCount();
+    if (!drops_.input_ended.load()) {
+      if (frames_after_warmup_ == 0) allocations_at_warmup_ = now;
+      allocations_at_last_ = now;
+      ++frames_after_warmup_;
+    }
+  }
+  // Last: the mapper and relocalizer are released to a waiting track stage.
+  fence_.frameMapped(!status.ok());
+  return status;
+}
+
+void MapStage::finish() {
+  const Status status = writeDrops(UINT32_MAX);
+  if (finish_status_.ok()) finish_status_ = status;
+}
+
+}  // namespace plumb

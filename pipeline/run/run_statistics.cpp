@@ -1,0 +1,133 @@
+#include "pipeline/run/run_statistics.h"
+
+#include <algorithm>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+
+#include "pipeline/odometry/map_capacities.h"
+#include "platform/process_memory.h"
+
+namespace plumb {
+
+RunStatistics::RunStatistics(long rss_every, std::size_t max_checkpoints)
+    : rss_every_(rss_every), max_checkpoints_(max_checkpoints) {
+  if (rss_every_ > 0) rss_.reserve(max_checkpoints_);
+}
+
+void RunStatistics::add(const FrameOutput& frame) {
+  if (frame.dropped) {
+    ++frames_dropped_;
+    return;
+  }
+  ++frames_;
+  auto ns = [](double ms) { return static_cast<int64_t>(std::llround(ms * 1e6)); };
+  extract_.add(ns(frame.extract_ms));
+  track_.add(ns(frame.track_ms));
+  map_.add(ns(frame.map_ms));
+  total_.add(ns(frame.extract_ms + frame.track_ms + frame.map_ms));
+  if (rss_every_ > 0 && frames_ % uint64_t(rss_every_) == 0 && rss_.size() < max_checkpoints_) {
+    RssCheckpoint c;
+    c.frame = frames_;
+    if (readRss(&c.peak_rss_kib, &c.current_rss_kib)) rss_.push_back(c);
+  }
+}
+
+namespace {
+
+// A JSON string literal (quotes, backslashes and control characters escaped).
+std::string jsonString(const std::string& text) {
+  std::string out = "\"";
+  for (const char ch : text) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += ch;
+    } else if (c < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof(buf), "\\u%04x", c);
+      out += buf;
+    } else {
+      out += ch;
+    }
+  }
+  return out + "\"";
+}
+
+// A finite number, or null (JSON has no inf/nan).
+std::string jsonNumber(double value, const char* format = "%.6f") {
+  if (!std::isfinite(value)) return "null";
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), format, value);
+  return buf;
+}
+
+}  // namespace
+
+std::string runSummaryJson(const RunSummary& r) {
+  const OdometryStats& s = r.odometry;
+  const MapperStats& m = r.mapper;
+  const OdometryOptions& o = r.system_options.odometry;
+  std::string out;
+  char buf[640];
+  auto add = [&out, &buf](int n) { out.append(buf, std::size_t(std::max(0, std::min(n, int(sizeof(buf)) - 1)))); };
+  out += "{\n  \"source\": " + jsonString(r.source) + ",\n";
+  add(std::snprintf(buf, sizeof(buf), "  \"frames\": %" PRIu64 ", \"frames_dropped\": %" PRIu64
+                    ", \"extraction_failures\": %" PRIu64 ", \"stopped_by_request\": %s,\n",
+                    r.statistics->frames(), r.statistics->framesDropped(), r.run->extraction_failures,
+                    r.run->stopped ? "true" : "false"));
+  add(std::snprintf(buf, sizeof(buf),
+                    "  \"tracking\": {\"ok\": %" PRIu64 ", \"weak\": %" PRIu64 ", \"lost\": %" PRIu64
+                    ", \"not_initialized\": %" PRIu64 ", \"motion_fallback\": %" PRIu64 "},\n",
+                    s.frames_ok, s.frames_weak, s.frames_lost, s.frames_not_initialized, s.frames_motion_fallback));
+  add(std::snprintf(buf, sizeof(buf),
+                    "  \"keyframes\": %" PRIu64 ", \"segments\": %" PRIu64 ", \"relocalizations\": %" PRIu64
+                    ", \"relocalization_attempts\": %" PRIu64 ",\n",
+                    s.keyframes, s.segments, s.relocalizations, s.relocalization_attempts));
+  add(std::snprintf(buf, sizeof(buf),
+                    "  \"map\": {\"points_created\": %" PRIu64 ", \"lines_created\": %" PRIu64
+                    ", \"points_culled\": %" PRIu64 ", \"lines_culled\": %" PRIu64 ", \"ba_runs\": %" PRIu64
+                    ", \"ba_outlier_observations\": %" PRIu64 ",\n",
+                    m.points_created, m.lines_created, m.points_culled, m.lines_culled, m.ba_runs,
+                    m.ba_outlier_observations));
+  add(std::snprintf(buf, sizeof(buf),
+                    "          \"peak\": {\"keyframes\": %zu, \"points\": %zu, \"lines\": %zu, "
+                    "\"point_observations\": %zu, \"line_observations\": %zu},\n",
+                    m.peak.keyframes, m.peak.points, m.peak.lines, m.peak.point_observations,
+                    m.peak.line_observations));
+  add(std::snprintf(buf, sizeof(buf),
+                    "          \"capacity\": {\"keyframes\": %zu, \"points\": %zu, \"lines\": %zu}},\n",
+                    kMaxMapKeyframes, kMaxMapPoints, kMaxMapLines));
+  auto timing = [&](const char* name, const runtime::LatencyHistogram& h, bool last) {
+    add(std::snprintf(buf, sizeof(buf), "    \"%s\": {\"mean\": %.3f, \"p50\": %.3f, \"p99\": %.3f, \"max\": %.3f}%s\n",
+                      name, h.meanNs() * 1e-6, double(h.percentileNs(0.5)) * 1e-6,
+                      double(h.percentileNs(0.99)) * 1e-6, double(h.maxNs()) * 1e-6, last ? "" : ","));
+  };
+  out += "  \"ms_per_frame\": {\n";
+  timing("total", r.statistics->totalNs(), false);
+  timing("extract", r.statistics->extractNs(), false);
+  timing("track", r.statistics->trackNs(), false);
+  timing("map", r.statistics->mapNs(), true);
+  out += "  },\n";
+  // The options the run actually used (after defaults and flags), so a result can be reproduced.
+  add(std::snprintf(buf, sizeof(buf),
+                    "  \"options\": {\"mode\": \"%s\", \"slots\": %zu, \"max_frames\": %ld, \"output_delay_frames\": %d,\n"
+                    "              \"line_samples\": %d, \"lines\": %s, \"min_line_inliers\": %d, \"num_features\": %d,\n"
+                    "              \"pyramid_levels\": %d, \"max_lines\": %d, \"ba_keyframes\": %d, \"ba_iterations\": %d},\n",
+                    runtime::runModeName(r.run_options.schedule.mode), r.run_options.schedule.slot_count,
+                    r.run_options.max_frames, r.system_options.output_delay_frames, o.extractor.line_samples,
+                    o.tracker.use_lines ? "true" : "false", o.extractor.min_line_inliers, o.extractor.num_features,
+                    o.extractor.num_levels, o.extractor.max_lines, o.mapper.ba_optimised_keyframes,
+                    o.mapper.ba_iterations));
+  out += "  \"rss_checkpoints\": [";
+  const std::vector<RssCheckpoint>& rss = r.statistics->rss();
+  for (std::size_t i = 0; i < rss.size(); ++i) {
+    add(std::snprintf(buf, sizeof(buf), "%s{\"frame\": %" PRIu64 ", \"peak_kib\": %ld, \"current_kib\": %ld}",
+                      i ? ", " : "", rss[i].frame, rss[i].peak_rss_kib, rss[i].current_rss_kib));
+  }
+  out += "],\n";
+  out += "  \"ate_rmse_m\": " + (r.ate_rmse_m >= 0 ? jsonNumber(r.ate_rmse_m) : std::string("null")) + "\n}\n";
+  return out;
+}
+
+}  // namespace plumb

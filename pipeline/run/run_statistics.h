@@ -1,0 +1,60 @@
+#pragma once
+// RunStatistics: what `plumb run --stats` reports about a run, gathered from the runner's sink
+// calls (pipeline/run/odometry_run.h) in fixed memory: per-stage milliseconds in fixed histograms
+// (runtime/latency_histogram.h), optional RSS checkpoints, and at the end the system's counters
+// and the options the run actually used. Formats JSON as a string; writing files is the caller's.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "pipeline/odometry/odometry_system.h"
+#include "pipeline/run/odometry_run.h"
+#include "runtime/latency_histogram.h"
+
+namespace plumb {
+
+struct RssCheckpoint {
+  uint64_t frame = 0;
+  long peak_rss_kib = 0;
+  long current_rss_kib = 0;
+};
+
+class RunStatistics {
+ public:
+  // rss_every > 0: a resident-memory checkpoint every that many frames (reserved up to
+  // max_checkpoints, later ones are not kept).
+  explicit RunStatistics(long rss_every = 0, std::size_t max_checkpoints = 4096);
+
+  // A tracked or dropped frame (the sink's onFrame).
+  void add(const FrameOutput& frame);
+
+  uint64_t frames() const { return frames_; }
+  uint64_t framesDropped() const { return frames_dropped_; }
+  const runtime::LatencyHistogram& totalNs() const { return total_; }
+  const runtime::LatencyHistogram& extractNs() const { return extract_; }
+  const runtime::LatencyHistogram& trackNs() const { return track_; }
+  const runtime::LatencyHistogram& mapNs() const { return map_; }
+  const std::vector<RssCheckpoint>& rss() const { return rss_; }
+
+ private:
+  long rss_every_;
+  std::size_t max_checkpoints_;
+  uint64_t frames_ = 0, frames_dropped_ = 0;
+  runtime::LatencyHistogram total_, extract_, track_, map_;
+  std::vector<RssCheckpoint> rss_;
+};
+
+// Everything --stats reports, as one JSON object. ate_rmse_m < 0: not evaluated (null).
+struct RunSummary {
+  std::string source;
+  const RunStatistics* statistics = nullptr;
+  const OdometryRunResult* run = nullptr;
+  OdometryStats odometry;
+  MapperStats mapper;
+  SystemOptions system_options;
+  OdometryRunOptions run_options;
+  double ate_rmse_m = -1;
+};
+std::string runSummaryJson(const RunSummary& summary);
+
+}  // namespace plumb

@@ -1,0 +1,132 @@
+#pragma once
+// Test helpers: run the odometry over a FrameSource through THE runner (pipeline/run/odometry_run.h,
+// the same loop `plumb run` uses) and collect the trajectory, per-frame outputs and counters.
+// GeneratedSource makes a FrameSource of frames a test draws itself (blank frames, scene cuts).
+#include <algorithm>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "drivers/common/frame_source.h"
+#include "drivers/common/source_capture.h"
+#include "drivers/synth/synth_spec.h"
+#include "drivers/synth/synthetic_scene.h"
+#include "drivers/trajectory/evaluate.h"
+#include "drivers/trajectory/trajectory_io.h"
+#include "pipeline/run/odometry_run.h"
+
+namespace plumb::test {
+
+struct OdometryRun {
+  Status status;
+  std::vector<StampedPose> trajectory;  // one per input frame, in order
+  std::vector<FrameOutput> outputs;     // per frame as mapped (when asked for)
+  OdometryStats stats;
+  MapperStats mapper;
+  OdometryRunResult result;
+  std::size_t max_keyframes = 0, max_points = 0, max_lines = 0;  // largest counts seen per frame
+};
+
+// Collects what the runner delivers; reads the map counts on the map stage's thread.
+class CollectingSink final : public OdometrySink {
+ public:
+  CollectingSink(const OdometrySystem& system, bool keep_outputs, OdometryRun* run)
+      : system_(system), keep_outputs_(keep_outputs), run_(run) {}
+  Status onFrame(const FrameOutput& out) override {
+    if (keep_outputs_) run_->outputs.push_back(out);
+    const MapCounts c = system_.mapCounts();
+    run_->max_keyframes = std::max(run_->max_keyframes, c.keyframes);
+    run_->max_points = std::max(run_->max_points, c.points);
+    run_->max_lines = std::max(run_->max_lines, c.lines);
+    return Status::Ok();
+  }
+  Status onFinishedFrame(const FinishedFrame& f) override {
+    StampedPose p;
+    p.timestamp = f.timestamp_s;
+    p.T_world_cam = f.T_world_cam;
+    p.valid = f.valid;
+    p.dropped = f.dropped;
+    run_->trajectory.push_back(p);
+    return Status::Ok();
+  }
+
+ private:
+  const OdometrySystem& system_;
+  bool keep_outputs_;
+  OdometryRun* run_;
+};
+
+struct RunSettings {
+  long max_frames = -1;
+  runtime::RunMode mode = runtime::RunMode::kDeterministic;
+  bool keep_outputs = false;
+};
+
+inline OdometryRun runOdometry(FrameSource& source, const SystemOptions& options, const RunSettings& settings = {}) {
+  OdometryRun run;
+  std::unique_ptr<OdometrySystem> system;
+  run.status = OdometrySystem::create(source.camera(), options, &system);
+  if (!run.status.ok()) return run;
+  CollectingSink sink(*system, settings.keep_outputs, &run);
+  SourceCapture capture(source);
+  OdometryRunOptions run_options;
+  run_options.schedule.mode = settings.mode;
+  run_options.max_frames = settings.max_frames;
+  run.status = runOdometry(capture, *system, sink, run_options, &run.result);
+  run.stats = system->stats();
+  run.mapper = system->mapperStats();
+  return run;
+}
+
+// A FrameSource of `count` frames drawn by `draw(index, image)` (which sets sequence and times).
+class GeneratedSource final : public FrameSource {
+ public:
+  using DrawFn = std::function<Status(int index, RgbdImage& image)>;
+  GeneratedSource(const PinholeCamera& camera, int count, DrawFn draw)
+      : camera_(camera), count_(count), draw_(std::move(draw)) {}
+  SourceResult next(RgbdImage& out) override {
+    if (next_ >= count_) return SourceResult::kEndOfStream;
+    error_ = draw_(next_++, out);
+    return error_.ok() ? SourceResult::kFrame : SourceResult::kError;
+  }
+  const PinholeCamera& camera() const override { return camera_; }
+  std::string describe() const override { return "generated"; }
+  const Status& lastError() const override { return error_; }
+  std::size_t frameCount() const override { return std::size_t(count_); }
+
+ private:
+  PinholeCamera camera_;
+  int count_;
+  DrawFn draw_;
+  int next_ = 0;
+  Status error_;
+};
+
+inline SynthOptions noisySynth(const std::string& preset, int frames) {
+  SynthOptions o;
+  o.preset = preset;
+  o.frames = frames;
+  o.depth_noise = true;
+  o.depth_edge_holes = true;
+  o.pixel_noise_sigma = 1.0;
+  return o;
+}
+
+inline std::vector<StampedPose> groundTruth(const SyntheticScene& scene, int frames) {
+  return syntheticGroundTruth(scene, frames);
+}
+
+inline double ateRmse(const std::vector<StampedPose>& gt, const std::vector<StampedPose>& est) {
+  AteResult ate;
+  const Status st = evaluateAte(gt, est, AteOptions{}, &ate);
+  return st.ok() ? ate.translation_m.rmse : 1e9;
+}
+
+inline SystemOptions systemOptions(bool lines) {
+  SystemOptions o;
+  o.odometry.tracker.use_lines = lines;
+  return o;
+}
+
+}  // namespace plumb::test

@@ -1,0 +1,84 @@
+#include "tools/run_outputs.h"
+
+#include <cinttypes>
+#include <cstdio>
+#include <memory>
+
+#include "drivers/common/source_capture.h"
+
+namespace plumb::tools {
+
+RunOutputs::RunOutputs(const RunOutputOptions& options) : options_(options), statistics_(options.rss_every) {
+  // Reserved once so keeping poses for the ATE costs no allocation per frame.
+  if (options_.keep_trajectory) trajectory_.reserve(options_.expected_frames);
+}
+
+Status RunOutputs::open() {
+  if (!options_.trajectory_path.empty()) PLUMB_RETURN_IF_ERROR(trajectory_writer_.open(options_.trajectory_path));
+  if (!options_.covariance_path.empty()) PLUMB_RETURN_IF_ERROR(covariance_writer_.open(options_.covariance_path));
+  return Status::Ok();
+}
+
+Status RunOutputs::close() {
+  if (!options_.trajectory_path.empty()) PLUMB_RETURN_IF_ERROR(trajectory_writer_.close());
+  if (!options_.covariance_path.empty()) PLUMB_RETURN_IF_ERROR(covariance_writer_.close());
+  return Status::Ok();
+}
+
+Status RunOutputs::onFrame(const FrameOutput& out) {
+  statistics_.add(out);
+  if (out.dropped) return Status::Ok();
+  keyframes_ += out.keyframe;
+  lost_ += !out.has_pose;
+  const uint64_t frame = statistics_.frames();
+  if (options_.trace) {
+    const Eigen::Vector3d t = out.T_world_cam.translation();
+    std::fprintf(stderr, "%" PRIu64 " %s fm %d lm %d pi %d li %d lmi %d kf %d np %d nl %d reloc %d fb %d t %.3f %.3f %.3f\n",
+                 frame, toString(out.state), out.track.frame_matches, out.track.local_map_matches,
+                 out.track.point_inliers, out.track.line_inliers, out.track.landmark_inliers, out.keyframe,
+                 out.insert.new_points, out.insert.new_lines, out.relocalized, out.track.used_motion_fallback,
+                 t.x(), t.y(), t.z());
+  }
+  if (options_.progress && frame % 100 == 0) {
+    std::fprintf(stderr, "frame %" PRIu64 ": %s, keyframes %" PRIu64 ", without pose %" PRIu64 "\n", frame,
+                 toString(out.state), keyframes_, lost_);
+  }
+  return Status::Ok();
+}
+
+Status RunOutputs::onFinishedFrame(const FinishedFrame& f) {
+  StampedPose pose;
+  pose.timestamp = f.timestamp_s;
+  pose.T_world_cam = f.T_world_cam;
+  pose.valid = f.valid;
+  pose.dropped = f.dropped;
+  if (options_.keep_trajectory) trajectory_.push_back(pose);
+  if (!options_.trajectory_path.empty()) return trajectory_writer_.append(pose);
+  return Status::Ok();
+}
+
+Status RunOutputs::onRetiredKeyframe(const RetiredKeyframe& kf) {
+  if (options_.covariance_path.empty()) return Status::Ok();
+  StampedCovariance c;
+  c.timestamp = kf.timestamp_s;
+  c.valid = kf.covariance_valid;
+  c.covariance = kf.covariance;
+  return covariance_writer_.append(c);
+}
+
+Status runToOutputs(FrameSource& source, const SystemOptions& system_options, const OdometryRunOptions& run_options,
+                    RunOutputs& outputs, RunRecord* record) {
+  std::unique_ptr<OdometrySystem> system;
+  PLUMB_RETURN_IF_ERROR(OdometrySystem::create(source.camera(), system_options, &system));
+  PLUMB_RETURN_IF_ERROR(validate(run_options));
+  PLUMB_RETURN_IF_ERROR(outputs.open());
+  SourceCapture capture(source);
+  Status status = runOdometry(capture, *system, outputs, run_options, &record->run);
+  const Status closed = outputs.close();
+  if (status.ok()) status = closed;
+  record->odometry = system->stats();
+  record->mapper = system->mapperStats();
+  return status;
+}
+
+}  // namespace plumb::tools

@@ -1,0 +1,61 @@
+#pragma once
+// RunOutputs: where `plumb run` and `plumb demo` send what the runner (pipeline/run/odometry_run.h)
+// produces: the TUM trajectory file, the keyframe covariance file, the poses kept in memory for the
+// ATE, statistics, and the --trace / --progress lines. Glue only: the formats live in
+// drivers/trajectory/, the statistics in pipeline/run/run_statistics.h.
+#include <string>
+#include <vector>
+
+#include "drivers/common/frame_source.h"
+#include "drivers/trajectory/covariance_io.h"
+#include "drivers/trajectory/trajectory_io.h"
+#include "pipeline/run/odometry_run.h"
+#include "pipeline/run/run_statistics.h"
+
+namespace plumb::tools {
+
+struct RunOutputOptions {
+  std::string trajectory_path;  // TUM file, one line per input frame ('' = none)
+  std::string covariance_path;  // one line per keyframe ('' = none)
+  bool keep_trajectory = true;  // poses in memory (for the ATE); off for very long runs
+  std::size_t expected_frames = 0;  // reserve for the kept poses (0: unknown, the vector grows)
+  long rss_every = 0;           // > 0: an RSS checkpoint every this many frames
+  bool progress = false;        // a line per 100 frames on stderr
+  bool trace = false;           // a line per frame on stderr (matches, inliers, keyframes, pose)
+};
+
+class RunOutputs final : public OdometrySink {
+ public:
+  explicit RunOutputs(const RunOutputOptions& options);
+  Status open();   // the files
+  Status close();  // flushes and closes them
+
+  Status onFrame(const FrameOutput& frame) override;
+  Status onFinishedFrame(const FinishedFrame& frame) override;
+  Status onRetiredKeyframe(const RetiredKeyframe& keyframe) override;
+
+  const std::vector<StampedPose>& trajectory() const { return trajectory_; }
+  const RunStatistics& statistics() const { return statistics_; }
+
+ private:
+  RunOutputOptions options_;
+  TumTrajectoryWriter trajectory_writer_;
+  CovarianceWriter covariance_writer_;
+  std::vector<StampedPose> trajectory_;
+  RunStatistics statistics_;
+  uint64_t keyframes_ = 0, lost_ = 0;
+};
+
+// What a run leaves besides its outputs.
+struct RunRecord {
+  OdometryRunResult run;
+  OdometryStats odometry;
+  MapperStats mapper;
+};
+
+// Builds the system (options validated there), runs it over `source` through the one runner into
+// `outputs` (opened first, closed after, also when the run failed: what was computed is kept).
+Status runToOutputs(FrameSource& source, const SystemOptions& system_options, const OdometryRunOptions& run_options,
+                    RunOutputs& outputs, RunRecord* record);
+
+}  // namespace plumb::tools
