@@ -324,6 +324,8 @@ class Checker:
 
     def note_folder_edge(self, src_rel, dst_rel, where):
         a, b = os.path.dirname(src_rel), os.path.dirname(dst_rel)
+        # Only edges the rules allow: a forbidden edge is reported as such, and as the rules
+        # between layers form no cycle, any cycle left is among folders of one layer.
         if a != b:
             self.folder_edges.setdefault((a, b), where)
 
@@ -372,6 +374,7 @@ class Checker:
         if not layer_may_use(layer, used):
             self.report(rel, line, "#include %s -> %s: %s/ must not include %s/" %
                         (shown, target, layer, used))
+            return
         self.note_folder_edge(rel, target, "%s:%d" % (rel, line))
 
     # ---- folder cycles
@@ -394,9 +397,11 @@ class Checker:
     # ---- CMake
     def check_cmake(self):
         model = CMakeModel(self.root)
-        for rel in walk_tree(self.root):
-            if os.path.basename(rel) == "CMakeLists.txt" or rel.endswith(".cmake"):
-                model.run_file(rel)
+        files = [rel for rel in walk_tree(self.root)
+                 if os.path.basename(rel) == "CMakeLists.txt" or rel.endswith(".cmake")]
+        # Modules first: they define the functions that CMakeLists.txt files call.
+        for rel in sorted(files, key=lambda r: (not r.endswith(".cmake"), r.count("/"), r)):
+            model.run_file(rel)
         for problem in model.problems:
             self.report(*problem)
         for name, target in sorted(model.targets.items()):
@@ -660,7 +665,9 @@ class CMakeModel:
                 out.extend(v for v in value.split(";") if v != "")
         return out
 
-    def execute(self, commands, variables, rel, directory):
+    def execute(self, commands, variables, rel, directory, call_line=None):
+        """Runs commands; inside a function body, call_line is the line of the call, so a
+        violation points at the call that supplied the arguments."""
         i = 0
         while i < len(commands):
             name, args, line = commands[i]
@@ -701,11 +708,11 @@ class CMakeModel:
                     for item in items:
                         scope = dict(variables)
                         scope[var] = item
-                        self.execute(body, scope, rel, directory)
+                        self.execute(body, scope, rel, directory, call_line)
                 i = j + 1
                 continue
-            self.command(name, self.expand_args(args, variables), variables, (rel, line),
-                         directory)
+            where = (rel, call_line if call_line is not None else line)
+            self.command(name, self.expand_args(args, variables), variables, where, directory)
             i += 1
 
     def source_path(self, value, directory):
@@ -726,7 +733,7 @@ class CMakeModel:
                 scope["ARGV%d" % k] = w
             scope["ARGN"] = ";".join(words[len(params):])
             scope["ARGV"] = ";".join(words)
-            self.execute(body, scope, where[0], directory)
+            self.execute(body, scope, where[0], directory, where[1])
             return
         if name == "set" and words:
             values = words[1:]
