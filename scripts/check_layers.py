@@ -296,30 +296,24 @@ class Checker:
     def report(self, path, line, message):
         self.violations.append((path, line, message))
 
-    def in_tree_file(self, rel):
-        full = os.path.join(self.root, rel)
-        if not os.path.isfile(full):
-            return False
-        real = os.path.realpath(full)
-        return real == self.root or real.startswith(self.root + os.sep)
-
     def resolve(self, including_rel, spelled, kind):
-        """Repository-relative path the compiler would open, 'outside' for a path that leaves
-        the tree, or None when it is not a file of the tree."""
+        """Repository-relative real path of the file the compiler would open, 'outside' for a
+        file out of the tree, or None when there is no such file. Symbolic links are followed
+        (component by component, as the kernel does), so a link cannot move a file into
+        another layer."""
         candidates = []
         if kind == '"':
             candidates.append(os.path.join(os.path.dirname(including_rel), spelled))
         candidates.append(spelled)  # the source root is the only project include directory
         for cand in candidates:
-            norm = os.path.normpath(cand).replace(os.sep, "/")
-            if norm.startswith("../") or norm == ".." or os.path.isabs(norm):
-                if os.path.isfile(os.path.join(self.root, cand)):
-                    return "outside"
+            if os.path.isabs(cand):
+                return "outside" if os.path.isfile(cand) else None
+            real = os.path.realpath(os.path.join(self.root, cand))
+            if not os.path.isfile(real):
                 continue
-            if self.in_tree_file(norm):
-                return norm
-            if os.path.isfile(os.path.join(self.root, norm)):
-                return "outside"  # a symbolic link out of the tree
+            if not real.startswith(self.root + os.sep):
+                return "outside"
+            return os.path.relpath(real, self.root).replace(os.sep, "/")
         return None
 
     def note_folder_edge(self, src_rel, dst_rel, where):
@@ -720,6 +714,19 @@ class CMakeModel:
         return os.path.normpath(os.path.relpath(os.path.realpath(path), self.root)).replace(
             os.sep, "/")
 
+    def add_sources(self, entry, values, where, directory):
+        for value in values:
+            objects = re.fullmatch(r"\$<TARGET_OBJECTS:([^>]+)>", value)
+            if objects:  # another target's object files: as good as linking it
+                entry["links"].append((objects.group(1), where))
+            elif "$<" in value:
+                continue  # other generator expressions select flags or configurations
+            elif "${" in value:
+                self.problems.append((where[0], where[1], "source %s: a variable this check "
+                                      "cannot see (set it in the same file)" % value))
+            else:
+                entry["sources"].append((self.source_path(value, directory), where))
+
     def command(self, name, words, variables, where, directory):
         keywords = {"PUBLIC", "PRIVATE", "INTERFACE", "LINK_PUBLIC", "LINK_PRIVATE",
                     "LINK_INTERFACE_LIBRARIES", "debug", "optimized", "general", "SYSTEM",
@@ -777,14 +784,12 @@ class CMakeModel:
             entry = self.targets.setdefault(target, {
                 "dir": directory, "where": where, "sources": [], "links": [],
                 "include_dirs": []})
-            entry["sources"] += [(self.source_path(s, directory), where)
-                                 for s in rest if s not in skip and "$" not in s]
+            self.add_sources(entry, [s for s in rest if s not in skip], where, directory)
         elif name == "target_sources" and words:
             entry = self.targets.get(words[0])
             if entry is not None:
-                entry["sources"] += [(self.source_path(s, directory), where) for s in words[1:]
-                                     if s not in ("PUBLIC", "PRIVATE", "INTERFACE")
-                                     and "$" not in s]
+                self.add_sources(entry, [s for s in words[1:] if s not in
+                                         ("PUBLIC", "PRIVATE", "INTERFACE")], where, directory)
         elif name == "target_link_libraries" and words:
             entry = self.targets.get(words[0])
             if entry is None:

@@ -339,6 +339,22 @@ class LayerCheckTest(unittest.TestCase):
         self.expect_only("tests/CMakeLists.txt:12:", "plumb_test_pipeline (tests/pipeline/) "
                          "compiles tools/main.cpp")
 
+    def test_object_library_of_pipeline_in_drivers(self):
+        self.append("drivers/CMakeLists.txt", "target_sources(plumb_drivers PRIVATE $<TARGET_OBJECTS:plumb_pipeline>)\n")
+        self.expect_only("drivers/CMakeLists.txt:8:", "drivers/ must not link pipeline/")
+
+    def test_source_list_the_check_cannot_see(self):
+        self.append("drivers/CMakeLists.txt", "target_sources(plumb_drivers PRIVATE ${FROM_ELSEWHERE})\n")
+        self.expect_only("drivers/CMakeLists.txt:8:", "${FROM_ELSEWHERE}", "cannot see")
+
+    def test_symbolic_link_into_another_layer(self):
+        os.symlink(os.path.join(self.root, "drivers"),
+                   os.path.join(self.root, "pipeline", "frontend", "devices"))
+        self.append("pipeline/frontend/extractor.cpp",
+                    '#include "pipeline/frontend/devices/common/frame_source.h"\n')
+        self.expect_only("pipeline/frontend/extractor.cpp:3:", "drivers/common/frame_source.h",
+                         "pipeline/frontend/ must not include drivers/")
+
     def test_include_directory_other_than_root(self):
         self.append("pipeline/CMakeLists.txt", "target_include_directories(plumb_pipeline PUBLIC ${CMAKE_SOURCE_DIR}/tools)\n")
         self.expect_only("pipeline/CMakeLists.txt:7:", "adds include directory tools")
