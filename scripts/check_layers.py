@@ -325,16 +325,23 @@ class Checker:
 
     # ---- includes
     def check_sources(self):
-        for rel in walk_tree(self.root):
-            if not rel.endswith(SOURCE_EXTENSIONS):
+        pending = [rel for rel in walk_tree(self.root) if rel.endswith(SOURCE_EXTENSIONS)]
+        scanned = set()
+        while pending:
+            rel = pending.pop(0)
+            if rel in scanned:
                 continue
+            scanned.add(rel)
             layer = layer_of(rel)
             if layer is None:
                 self.report(rel, 0, "source file in no layer folder (see ALLOWED_LAYERS in "
                             "scripts/check_layers.py)")
                 continue
             for line, spelled, kind in read_includes(os.path.join(self.root, rel)):
-                self.check_include(rel, layer, line, spelled, kind)
+                target = self.check_include(rel, layer, line, spelled, kind)
+                # An included file is code whatever its name (x.inc, x.def): read it too.
+                if target is not None and target not in scanned:
+                    pending.append(target)
 
     def check_include(self, rel, layer, line, spelled, kind):
         shown = {'"': '"%s"', "<": "<%s>", "?": "%s"}[kind] % spelled
@@ -370,6 +377,7 @@ class Checker:
                         (shown, target, layer, used))
             return
         self.note_folder_edge(rel, target, "%s:%d" % (rel, line))
+        return target
 
     # ---- folder cycles
     def check_cycles(self):
@@ -828,10 +836,10 @@ class CMakeModel:
 def print_rules():
     print("Layer           may include/link (besides itself)")
     for layer, used in ALLOWED_LAYERS.items():
-        print("  %-16s %s" % (layer, ", ".join(used) or "-"))
+        print("  %-18s %s" % (layer, ", ".join(used) or "-"))
     print("External header families per layer")
     for layer, fams in ALLOWED_FAMILIES.items():
-        print("  %-16s %s" % (layer, ", ".join(fams)))
+        print("  %-18s %s" % (layer, ", ".join(fams)))
     print("solver/ must not include: " + " ".join("<%s>" % h for h in
                                                   sorted(SOLVER_FORBIDDEN_STD)))
 

@@ -283,6 +283,11 @@ class LayerCheckTest(unittest.TestCase):
                 write_tree(self.root, {"solver/extra.cpp": text})
                 self.expect_only("solver/extra.cpp:1:", "<thread>")
 
+    def test_included_file_with_another_extension(self):
+        write_tree(self.root, {"solver/kernels.inc": "#include <mutex>\n"})
+        self.append("solver/se3.cpp", '#include "kernels.inc"\n')
+        self.expect_only("solver/kernels.inc:1:", "<mutex>", "solver/ must not use threads/files")
+
     def test_computed_include(self):
         self.append("runtime/ring.cpp", "#define HEADER <thread>\n#include HEADER\n")
         self.expect_only("runtime/ring.cpp:4:", "computed include")
