@@ -355,8 +355,9 @@ class Checker:
         if target is None:
             if kind == '"':
                 self.report(rel, line, "#include %s is not a file of the tree: a quoted include "
-                            "would silently pick up a system or include-path header; use "
-                            "<...> for system headers or spell the project path" % shown)
+                            "must name a project file (next to this one or from the source "
+                            "root), else the compiler silently takes a system header of that "
+                            "name; use <...> for system headers" % shown)
                 return
             family = header_family(spelled)
             if family is None:
