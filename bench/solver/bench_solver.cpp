@@ -15,8 +15,8 @@
 #include "solver/local_ba.h"
 #include "solver/pose_optimizer.h"
 #include "solver/se3.h"
-#include "tests/solver/synthetic_pose_problem.h"
-#include "tests/solver/synthetic_window.h"
+#include "tests/support/synthetic_pose_problem.h"
+#include "tests/support/synthetic_window.h"
 
 namespace {
 

@@ -3,7 +3,7 @@
 // factor of each information matrix), Pseudo-Huber = ceres::SoftLOneLoss(delta), the left-
 // perturbation SE(3) manifold, fixed keyframes constant, DENSE_SCHUR with landmarks eliminated.
 #include "solver/local_ba.h"
-#include "tests/solver/synthetic_window.h"
+#include "tests/support/synthetic_window.h"
 
 namespace plumb::bench {
 

@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "solver/local_ba.h"
-#include "tests/solver/synthetic_window.h"
+#include "tests/support/synthetic_window.h"
 
 namespace plumb::testing {
 namespace {

@@ -9,7 +9,7 @@
 #include "solver/factors.h"
 #include "solver/local_ba.h"
 #include "solver/robust_kernel.h"
-#include "tests/solver/synthetic_window.h"
+#include "tests/support/synthetic_window.h"
 
 namespace plumb::testing {
 

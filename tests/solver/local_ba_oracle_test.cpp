@@ -5,7 +5,7 @@
 
 #include "solver/local_ba.h"
 #include "tests/solver/dense_oracle.h"
-#include "tests/solver/synthetic_window.h"
+#include "tests/support/synthetic_window.h"
 
 namespace plumb::testing {
 namespace {

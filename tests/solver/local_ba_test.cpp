@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "platform/allocation_counter.h"
-#include "tests/solver/synthetic_window.h"
+#include "tests/support/synthetic_window.h"
 
 namespace plumb::testing {
 namespace {

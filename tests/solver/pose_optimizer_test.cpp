@@ -9,7 +9,7 @@
 
 #include "platform/allocation_counter.h"
 #include "solver/se3.h"
-#include "tests/solver/synthetic_pose_problem.h"
+#include "tests/support/synthetic_pose_problem.h"
 
 namespace plumb::testing {
 namespace {

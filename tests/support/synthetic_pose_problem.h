@@ -7,7 +7,7 @@
 
 #include "solver/noise_model.h"
 #include "solver/pose_optimizer.h"
-#include "tests/solver/synthetic_window.h"
+#include "tests/support/synthetic_window.h"
 
 namespace plumb::testing {
 
