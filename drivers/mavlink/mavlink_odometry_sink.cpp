@@ -146,9 +146,8 @@ void MavlinkOdometrySink::publish(const OdometrySample& sample, int64_t now_ns) 
     has_previous_ = false;
     return;
   }
-  MavlinkOdometry message;
-  buildOdometry(sample, &message);
-  packOdometryPayload(message, payload_);
+  buildOdometry(sample, &last_odometry_);
+  packOdometryPayload(last_odometry_, payload_);
   if (sendMessage(kMavlinkMsgIdOdometry, kMavlinkCrcExtraOdometry, payload_,
                   kMavlinkOdometryPayloadBytes)) {
     ++stats_.odometry_sent;

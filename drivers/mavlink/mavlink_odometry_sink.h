@@ -76,6 +76,8 @@ class MavlinkOdometrySink {
   // the velocity history and the reset counter exactly as publish() does.
   void buildOdometry(const OdometrySample& sample, MavlinkOdometry* out);
 
+  // The ODOMETRY fields of the last sample with a pose (sent or dropped), e.g. to log them.
+  const MavlinkOdometry& lastOdometry() const { return last_odometry_; }
   const MavlinkStats& stats() const { return stats_; }
   const MavlinkOptions& options() const { return options_; }
 
@@ -87,6 +89,7 @@ class MavlinkOdometrySink {
   MavlinkFrameChange frames_;
   MavlinkTransport transport_;
   MavlinkStats stats_;
+  MavlinkOdometry last_odometry_;
   uint8_t sequence_ = 0;
   uint8_t reset_counter_ = 0;
   bool last_had_pose_ = false;
