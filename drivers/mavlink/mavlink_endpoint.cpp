@@ -68,8 +68,8 @@ Status parseMavlinkEndpoint(const std::string& spec, MavlinkEndpoint* out) {
     long baud = 0;
     if (!parseInteger(rest.substr(last + 1), 1, 100000000, &baud) ||
         !isSupportedSerialBaud(static_cast<int>(baud))) {
-      return endpointError(spec, "unsupported baud rate '" + rest.substr(last + 1) +
-                                     "' (use e.g. 57600, 115200, 921600)");
+      return endpointError(
+          spec, "unsupported baud rate '" + rest.substr(last + 1) + "' (use e.g. 57600, 115200, 921600)");
     }
     out->kind = MavlinkEndpoint::Kind::kSerial;
     out->device = device;

@@ -11,8 +11,8 @@ std::size_t mavlinkTruncatedPayloadLength(const uint8_t* payload, std::size_t si
   return size;
 }
 
-std::size_t writeMavlinkV2Frame(const MavlinkFrameHeader& header, uint8_t crc_extra,
-                                const uint8_t* payload, std::size_t payload_size, uint8_t* out) {
+std::size_t writeMavlinkV2Frame(const MavlinkFrameHeader& header, uint8_t crc_extra, const uint8_t* payload,
+                                std::size_t payload_size, uint8_t* out) {
   const std::size_t length = mavlinkTruncatedPayloadLength(payload, payload_size);
   out[0] = kMavlinkV2Stx;
   out[1] = static_cast<uint8_t>(length);

@@ -38,7 +38,7 @@ std::size_t mavlinkTruncatedPayloadLength(const uint8_t* payload, std::size_t si
 
 // Writes one complete v2 frame into out (capacity kMavlinkV2MaxFrameBytes) and returns its size.
 // payload_size must be <= kMavlinkMaxPayloadBytes.
-std::size_t writeMavlinkV2Frame(const MavlinkFrameHeader& header, uint8_t crc_extra,
-                                const uint8_t* payload, std::size_t payload_size, uint8_t* out);
+std::size_t writeMavlinkV2Frame(const MavlinkFrameHeader& header, uint8_t crc_extra, const uint8_t* payload,
+                                std::size_t payload_size, uint8_t* out);
 
 }  // namespace plumb

@@ -29,17 +29,17 @@ constexpr std::size_t kMavlinkOdometryBasePayloadBytes = 230;
 constexpr std::size_t kMavlinkOdometryPayloadBytes = 233;
 
 // Enum values used (minimal.xml / common.xml).
-constexpr uint8_t kMavTypeOnboardController = 18;        // MAV_TYPE_ONBOARD_CONTROLLER
-constexpr uint8_t kMavAutopilotInvalid = 8;              // MAV_AUTOPILOT_INVALID: not a flight stack
-constexpr uint8_t kMavStateActive = 4;                   // MAV_STATE_ACTIVE
-constexpr uint8_t kMavStateCritical = 5;                 // MAV_STATE_CRITICAL (tracking lost)
-constexpr uint8_t kMavlinkProtocolVersion = 3;           // HEARTBEAT.mavlink_version
+constexpr uint8_t kMavTypeOnboardController = 18;          // MAV_TYPE_ONBOARD_CONTROLLER
+constexpr uint8_t kMavAutopilotInvalid = 8;                // MAV_AUTOPILOT_INVALID: not a flight stack
+constexpr uint8_t kMavStateActive = 4;                     // MAV_STATE_ACTIVE
+constexpr uint8_t kMavStateCritical = 5;                   // MAV_STATE_CRITICAL (tracking lost)
+constexpr uint8_t kMavlinkProtocolVersion = 3;             // HEARTBEAT.mavlink_version
 constexpr uint8_t kMavCompIdVisualInertialOdometry = 197;  // MAV_COMP_ID_VISUAL_INERTIAL_ODOMETRY
-constexpr uint8_t kMavFrameLocalNed = 1;                 // MAV_FRAME_LOCAL_NED
-constexpr uint8_t kMavFrameBodyFrd = 12;                 // MAV_FRAME_BODY_FRD
-constexpr uint8_t kMavFrameLocalFrd = 20;                // MAV_FRAME_LOCAL_FRD
-constexpr uint8_t kMavEstimatorTypeVision = 2;           // MAV_ESTIMATOR_TYPE_VISION
-constexpr uint8_t kMavEstimatorTypeVio = 3;              // MAV_ESTIMATOR_TYPE_VIO
+constexpr uint8_t kMavFrameLocalNed = 1;                   // MAV_FRAME_LOCAL_NED
+constexpr uint8_t kMavFrameBodyFrd = 12;                   // MAV_FRAME_BODY_FRD
+constexpr uint8_t kMavFrameLocalFrd = 20;                  // MAV_FRAME_LOCAL_FRD
+constexpr uint8_t kMavEstimatorTypeVision = 2;             // MAV_ESTIMATOR_TYPE_VISION
+constexpr uint8_t kMavEstimatorTypeVio = 3;                // MAV_ESTIMATOR_TYPE_VIO
 
 struct MavlinkHeartbeat {
   uint32_t custom_mode = 0;

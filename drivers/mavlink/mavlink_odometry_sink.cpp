@@ -36,8 +36,8 @@ Status MavlinkOdometrySink::open(const MavlinkOptions& options) {
   return Status::Ok();
 }
 
-bool MavlinkOdometrySink::sendMessage(uint32_t message_id, uint8_t crc_extra,
-                                      const uint8_t* payload, std::size_t payload_size) {
+bool MavlinkOdometrySink::sendMessage(uint32_t message_id, uint8_t crc_extra, const uint8_t* payload,
+                                      std::size_t payload_size) {
   MavlinkFrameHeader header;
   header.sequence = sequence_++;  // dropped frames still use a number: receivers see the loss
   header.system_id = options_.system_id;
@@ -79,9 +79,7 @@ void MavlinkOdometrySink::buildOdometry(const OdometrySample& sample, MavlinkOdo
   const Eigen::Vector3d p = T_local_body.translation();
   const Eigen::Quaterniond q(T_local_body.linear());
 
-  m.time_usec = sample.timestamp_s > 0.0
-                    ? static_cast<uint64_t>(std::llround(sample.timestamp_s * 1e6))
-                    : 0u;
+  m.time_usec = sample.timestamp_s > 0.0 ? static_cast<uint64_t>(std::llround(sample.timestamp_s * 1e6)) : 0u;
   m.x = static_cast<float>(p.x());
   m.y = static_cast<float>(p.y());
   m.z = static_cast<float>(p.z());
@@ -96,8 +94,7 @@ void MavlinkOdometrySink::buildOdometry(const OdometrySample& sample, MavlinkOdo
   if (has_previous_ && dt > 1e-6) {
     const Eigen::Matrix3d& R = T_local_body.linear();
     const Eigen::Vector3d v_body = R.transpose() * (p - previous_T_local_body_.translation()) / dt;
-    const Eigen::Vector3d w_body =
-        logSO3(previous_T_local_body_.linear().transpose() * R) / dt;
+    const Eigen::Vector3d w_body = logSO3(previous_T_local_body_.linear().transpose() * R) / dt;
     m.vx = static_cast<float>(v_body.x());
     m.vy = static_cast<float>(v_body.y());
     m.vz = static_cast<float>(v_body.z());
@@ -129,9 +126,7 @@ void MavlinkOdometrySink::buildOdometry(const OdometrySample& sample, MavlinkOdo
   m.quality = static_cast<int8_t>(std::clamp(sample.tracking_quality, 0, 100));
 }
 
-void MavlinkOdometrySink::publish(const OdometrySample& sample) {
-  publish(sample, monotonicNowNs());
-}
+void MavlinkOdometrySink::publish(const OdometrySample& sample) { publish(sample, monotonicNowNs()); }
 
 void MavlinkOdometrySink::publish(const OdometrySample& sample, int64_t now_ns) {
   if (!isOpen()) return;
@@ -148,8 +143,7 @@ void MavlinkOdometrySink::publish(const OdometrySample& sample, int64_t now_ns) 
   }
   buildOdometry(sample, &last_odometry_);
   packOdometryPayload(last_odometry_, payload_);
-  if (sendMessage(kMavlinkMsgIdOdometry, kMavlinkCrcExtraOdometry, payload_,
-                  kMavlinkOdometryPayloadBytes)) {
+  if (sendMessage(kMavlinkMsgIdOdometry, kMavlinkCrcExtraOdometry, payload_, kMavlinkOdometryPayloadBytes)) {
     ++stats_.odometry_sent;
   }
 }

@@ -12,11 +12,10 @@
 //   sink.stats();                                    // sent / dropped / bytes
 //
 // Frames, covariance and field semantics: drivers/mavlink/odometry_frames.h, docs/MAVLINK.md.
-#include <cstdint>
-#include <string>
-
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cstdint>
+#include <string>
 
 #include "drivers/mavlink/mavlink_frame.h"
 #include "drivers/mavlink/mavlink_messages.h"
@@ -38,7 +37,7 @@ struct MavlinkOptions {
   // asserts the vehicle started level and facing north, or the autopilot rotates the frame).
   uint8_t frame_id = kMavFrameLocalFrd;
   uint8_t estimator_type = kMavEstimatorTypeVision;  // RGB-D odometry, no IMU
-  double heartbeat_period_s = 1.0;  // <= 0 disables the heartbeat
+  double heartbeat_period_s = 1.0;                   // <= 0 disables the heartbeat
 };
 
 // One odometry result, as the frame loop has it.
@@ -55,7 +54,7 @@ struct OdometrySample {
 struct MavlinkStats {
   uint64_t odometry_sent = 0;
   uint64_t heartbeats_sent = 0;
-  uint64_t dropped = 0;          // frames the transport could not take (would block / error)
+  uint64_t dropped = 0;  // frames the transport could not take (would block / error)
   uint64_t bytes_sent = 0;
   uint64_t skipped_no_pose = 0;  // samples with has_pose == false
   uint64_t resets = 0;           // reset_counter increments
@@ -82,8 +81,7 @@ class MavlinkOdometrySink {
   const MavlinkOptions& options() const { return options_; }
 
  private:
-  bool sendMessage(uint32_t message_id, uint8_t crc_extra, const uint8_t* payload,
-                   std::size_t payload_size);
+  bool sendMessage(uint32_t message_id, uint8_t crc_extra, const uint8_t* payload, std::size_t payload_size);
 
   MavlinkOptions options_;
   MavlinkFrameChange frames_;

@@ -16,25 +16,44 @@ namespace {
 
 speed_t termiosSpeed(int baud) {
   switch (baud) {
-    case 9600: return B9600;
-    case 19200: return B19200;
-    case 38400: return B38400;
-    case 57600: return B57600;
-    case 115200: return B115200;
-    case 230400: return B230400;
-    case 460800: return B460800;
-    case 500000: return B500000;
-    case 576000: return B576000;
-    case 921600: return B921600;
-    case 1000000: return B1000000;
-    case 1152000: return B1152000;
-    case 1500000: return B1500000;
-    case 2000000: return B2000000;
-    case 2500000: return B2500000;
-    case 3000000: return B3000000;
-    case 3500000: return B3500000;
-    case 4000000: return B4000000;
-    default: return B0;
+    case 9600:
+      return B9600;
+    case 19200:
+      return B19200;
+    case 38400:
+      return B38400;
+    case 57600:
+      return B57600;
+    case 115200:
+      return B115200;
+    case 230400:
+      return B230400;
+    case 460800:
+      return B460800;
+    case 500000:
+      return B500000;
+    case 576000:
+      return B576000;
+    case 921600:
+      return B921600;
+    case 1000000:
+      return B1000000;
+    case 1152000:
+      return B1152000;
+    case 1500000:
+      return B1500000;
+    case 2000000:
+      return B2000000;
+    case 2500000:
+      return B2500000;
+    case 3000000:
+      return B3000000;
+    case 3500000:
+      return B3500000;
+    case 4000000:
+      return B4000000;
+    default:
+      return B0;
   }
 }
 
@@ -59,8 +78,7 @@ Status MavlinkTransport::open(const MavlinkEndpoint& endpoint) {
     addrinfo* found = nullptr;
     const int rc = ::getaddrinfo(endpoint.host.c_str(), nullptr, &hints, &found);
     if (rc != 0 || found == nullptr) {
-      return Status::Error("mavlink udp: cannot resolve host '" + endpoint.host +
-                           "': " + ::gai_strerror(rc));
+      return Status::Error("mavlink udp: cannot resolve host '" + endpoint.host + "': " + ::gai_strerror(rc));
     }
     std::memcpy(&destination_, found->ai_addr, sizeof(destination_));
     ::freeaddrinfo(found);
@@ -91,8 +109,8 @@ Status MavlinkTransport::open(const MavlinkEndpoint& endpoint) {
       ::tcsetattr(fd_, TCSANOW, &tio) != 0) {
     const int err = errno;
     close();
-    return Status::Error("mavlink serial: cannot set '" + path + "' to " +
-                         std::to_string(endpoint.baud) + " baud raw: " + errnoText(err));
+    return Status::Error("mavlink serial: cannot set '" + path + "' to " + std::to_string(endpoint.baud) +
+                         " baud raw: " + errnoText(err));
   }
   is_udp_ = false;
   return Status::Ok();
@@ -118,8 +136,7 @@ bool MavlinkTransport::trySend(const uint8_t* frame, std::size_t size) {
   if (is_udp_) {
     for (;;) {
       const ssize_t n = ::sendto(fd_, frame, size, MSG_DONTWAIT | MSG_NOSIGNAL,
-                                 reinterpret_cast<const sockaddr*>(&destination_),
-                                 sizeof(destination_));
+                                 reinterpret_cast<const sockaddr*>(&destination_), sizeof(destination_));
       if (n == static_cast<ssize_t>(size)) return true;
       if (n < 0 && errno == EINTR) continue;
       last_errno_ = n < 0 ? errno : EMSGSIZE;

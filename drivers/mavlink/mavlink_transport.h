@@ -6,10 +6,10 @@
 // Serial ports accept partial writes; a torn frame would corrupt the stream, so the unwritten
 // tail of a frame is kept (one frame of fixed storage) and flushed before anything new. While a
 // tail is pending, new frames are dropped whole.
+#include <netinet/in.h>
+
 #include <cstddef>
 #include <cstdint>
-
-#include <netinet/in.h>
 
 #include "drivers/mavlink/mavlink_endpoint.h"
 #include "drivers/mavlink/mavlink_frame.h"

@@ -18,8 +18,7 @@ Eigen::Isometry3d forwardCameraBodyFrdExtrinsic() {
   return T;
 }
 
-Eigen::Isometry3d localBodyPose(const Eigen::Isometry3d& T_world_cam,
-                                const MavlinkFrameChange& frames) {
+Eigen::Isometry3d localBodyPose(const Eigen::Isometry3d& T_world_cam, const MavlinkFrameChange& frames) {
   return frames.T_local_world * T_world_cam * frames.T_body_cam.inverse();
 }
 
@@ -30,8 +29,7 @@ Eigen::Vector3d eulerRollPitchYaw(const Eigen::Matrix3d& R) {
   return {roll, pitch, yaw};
 }
 
-Matrix6d mavlinkPoseJacobian(const Eigen::Isometry3d& T_world_cam,
-                             const MavlinkFrameChange& frames) {
+Matrix6d mavlinkPoseJacobian(const Eigen::Isometry3d& T_world_cam, const MavlinkFrameChange& frames) {
   const Eigen::Isometry3d T_local_body = localBodyPose(T_world_cam, frames);
   const Eigen::Vector3d rpy = eulerRollPitchYaw(T_local_body.linear());
   const double sr = std::sin(rpy.x()), cr = std::cos(rpy.x());
@@ -55,8 +53,7 @@ Matrix6d mavlinkPoseJacobian(const Eigen::Isometry3d& T_world_cam,
   return -d_state_d_eps * adjoint_body_cam;
 }
 
-Matrix6d mavlinkPoseCovariance(const Matrix6d& covariance_delta,
-                               const Eigen::Isometry3d& T_world_cam,
+Matrix6d mavlinkPoseCovariance(const Matrix6d& covariance_delta, const Eigen::Isometry3d& T_world_cam,
                                const MavlinkFrameChange& frames) {
   const Matrix6d J = mavlinkPoseJacobian(T_world_cam, frames);
   return J * covariance_delta * J.transpose();

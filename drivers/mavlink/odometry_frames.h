@@ -40,20 +40,17 @@ struct MavlinkFrameChange {
 };
 
 // The body pose in the MAVLink local frame.
-Eigen::Isometry3d localBodyPose(const Eigen::Isometry3d& T_world_cam,
-                                const MavlinkFrameChange& frames);
+Eigen::Isometry3d localBodyPose(const Eigen::Isometry3d& T_world_cam, const MavlinkFrameChange& frames);
 
 // Aerospace ZYX Euler angles [roll, pitch, yaw] of R = Rz(yaw) Ry(pitch) Rx(roll).
 Eigen::Vector3d eulerRollPitchYaw(const Eigen::Matrix3d& R);
 
 // J = d[x y z roll pitch yaw] / d delta at delta = 0 (see the header comment). Near pitch = +-90
 // degrees the Euler rates are singular; check the covariance for finiteness.
-Matrix6d mavlinkPoseJacobian(const Eigen::Isometry3d& T_world_cam,
-                             const MavlinkFrameChange& frames);
+Matrix6d mavlinkPoseJacobian(const Eigen::Isometry3d& T_world_cam, const MavlinkFrameChange& frames);
 
 // Sigma_mav = J Sigma_delta J^T.
-Matrix6d mavlinkPoseCovariance(const Matrix6d& covariance_delta,
-                               const Eigen::Isometry3d& T_world_cam,
+Matrix6d mavlinkPoseCovariance(const Matrix6d& covariance_delta, const Eigen::Isometry3d& T_world_cam,
                                const MavlinkFrameChange& frames);
 
 // Row-major upper-right triangle (21 values: row 0 has 6, row 1 has 5, ...), as float.

@@ -61,11 +61,14 @@ TEST(MavlinkFrames, CameraMotionMapsToFrdAxes) {
   EXPECT_TRUE(T0.isApprox(Eigen::Isometry3d::Identity(), 1e-12));
   // Camera 1 m along its optical axis (world z) = 1 m forward (local x); world y (down) = local z.
   EXPECT_TRUE(localBodyPose(pose(Eigen::Vector3d::Zero(), {0, 0, 1}), frames)
-                  .translation().isApprox(Eigen::Vector3d(1, 0, 0), 1e-12));
+                  .translation()
+                  .isApprox(Eigen::Vector3d(1, 0, 0), 1e-12));
   EXPECT_TRUE(localBodyPose(pose(Eigen::Vector3d::Zero(), {0, 1, 0}), frames)
-                  .translation().isApprox(Eigen::Vector3d(0, 0, 1), 1e-12));
+                  .translation()
+                  .isApprox(Eigen::Vector3d(0, 0, 1), 1e-12));
   EXPECT_TRUE(localBodyPose(pose(Eigen::Vector3d::Zero(), {1, 0, 0}), frames)
-                  .translation().isApprox(Eigen::Vector3d(0, 1, 0), 1e-12));
+                  .translation()
+                  .isApprox(Eigen::Vector3d(0, 1, 0), 1e-12));
   // Turning right = rotating about the camera's down axis (y) by +a: yaw +a.
   const double a = 0.4;
   Eigen::Vector3d rpy = eulerRollPitchYaw(localBodyPose(pose({0, a, 0}, {0, 0, 0}), frames).linear());
@@ -87,8 +90,8 @@ TEST(MavlinkFrames, MountedCameraStartsAtLocalOrigin) {
       Eigen::AngleAxisd(-20 * kPi / 180, Eigen::Vector3d::UnitY()).toRotationMatrix() *
       frames.T_body_cam.linear();
   frames.T_local_world = frames.T_body_cam;
-  EXPECT_TRUE(localBodyPose(Eigen::Isometry3d::Identity(), frames)
-                  .isApprox(Eigen::Isometry3d::Identity(), 1e-12));
+  EXPECT_TRUE(
+      localBodyPose(Eigen::Isometry3d::Identity(), frames).isApprox(Eigen::Isometry3d::Identity(), 1e-12));
 }
 
 TEST(MavlinkCovariance, JacobianMatchesFiniteDifferences) {
@@ -97,17 +100,18 @@ TEST(MavlinkCovariance, JacobianMatchesFiniteDifferences) {
   for (int trial = 0; trial < 40; ++trial) {
     MavlinkFrameChange frames;
     if (trial % 2 == 1) {  // a non-trivial mounting: rotated and offset
-      frames.T_body_cam = pose({0.3 * u(rng), 0.3 * u(rng), 0.3 * u(rng)},
-                               {0.2 * u(rng), 0.2 * u(rng), 0.2 * u(rng)}) *
-                          forwardCameraBodyFrdExtrinsic();
+      frames.T_body_cam =
+          pose({0.3 * u(rng), 0.3 * u(rng), 0.3 * u(rng)}, {0.2 * u(rng), 0.2 * u(rng), 0.2 * u(rng)}) *
+          forwardCameraBodyFrdExtrinsic();
       frames.T_local_world = frames.T_body_cam;
     }
     const Eigen::Isometry3d T_world_cam =
         pose({0.6 * u(rng), 0.6 * u(rng), 0.6 * u(rng)}, {3 * u(rng), 3 * u(rng), 3 * u(rng)});
     const Matrix6d J = mavlinkPoseJacobian(T_world_cam, frames);
     const Matrix6d J_numeric = numericJacobian(T_world_cam, frames);
-    EXPECT_LT((J - J_numeric).cwiseAbs().maxCoeff(), 1e-6)
-        << "trial " << trial << "\nanalytic\n" << J << "\nnumeric\n" << J_numeric;
+    EXPECT_LT((J - J_numeric).cwiseAbs().maxCoeff(), 1e-6) << "trial " << trial << "\nanalytic\n"
+                                                           << J << "\nnumeric\n"
+                                                           << J_numeric;
 
     // The propagated covariance is J Sigma J^T with the numeric J.
     Matrix6d A;

@@ -1,11 +1,12 @@
 // MAVLink v2 framing and message layout, checked against values derived from the spec here.
+#include "drivers/mavlink/mavlink_frame.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstring>
 
 #include "drivers/mavlink/mavlink_crc.h"
-#include "drivers/mavlink/mavlink_frame.h"
 #include "drivers/mavlink/mavlink_messages.h"
 #include "mavlink_test_decoder.h"
 
@@ -37,12 +38,9 @@ TEST(MavlinkMessages, CrcExtraAndLengthsFromDefinitions) {
   EXPECT_EQ(crcExtra("ODOMETRY", odometryDefinition()), kMavlinkCrcExtraOdometry);
   EXPECT_EQ(kMavlinkCrcExtraHeartbeat, 50);
   EXPECT_EQ(kMavlinkCrcExtraOdometry, 91);
-  EXPECT_EQ(payloadBytes(heartbeatDefinition(), true),
-            static_cast<int>(kMavlinkHeartbeatPayloadBytes));
-  EXPECT_EQ(payloadBytes(odometryDefinition(), false),
-            static_cast<int>(kMavlinkOdometryBasePayloadBytes));
-  EXPECT_EQ(payloadBytes(odometryDefinition(), true),
-            static_cast<int>(kMavlinkOdometryPayloadBytes));
+  EXPECT_EQ(payloadBytes(heartbeatDefinition(), true), static_cast<int>(kMavlinkHeartbeatPayloadBytes));
+  EXPECT_EQ(payloadBytes(odometryDefinition(), false), static_cast<int>(kMavlinkOdometryBasePayloadBytes));
+  EXPECT_EQ(payloadBytes(odometryDefinition(), true), static_cast<int>(kMavlinkOdometryPayloadBytes));
 }
 
 // HEARTBEAT from sysid 1, compid 197, seq 0, worked out by hand from the spec:
@@ -53,8 +51,8 @@ TEST(MavlinkMessages, CrcExtraAndLengthsFromDefinitions) {
 //   crc     0xE41E over bytes 1..18 then CRC_EXTRA 50, low byte first: 1E E4
 //           (the same value from the bitwise CRC below and from node-mavlink's x25crc)
 TEST(MavlinkFrame, HeartbeatReferenceBytes) {
-  const uint8_t expected[] = {0xFD, 0x09, 0x00, 0x00, 0x00, 0x01, 0xC5, 0x00, 0x00, 0x00,
-                              0x00, 0x00, 0x00, 0x00, 0x12, 0x08, 0x00, 0x04, 0x03, 0x1E, 0xE4};
+  const uint8_t expected[] = {0xFD, 0x09, 0x00, 0x00, 0x00, 0x01, 0xC5, 0x00, 0x00, 0x00, 0x00,
+                              0x00, 0x00, 0x00, 0x12, 0x08, 0x00, 0x04, 0x03, 0x1E, 0xE4};
   uint16_t crc = 0xFFFF;
   for (int i = 1; i <= 18; ++i) crc = crcBitwise(crc, expected[i]);
   crc = crcBitwise(crc, 50);

@@ -1,9 +1,8 @@
 // MavlinkOdometrySink end to end over real sockets and a pseudo-terminal: what arrives decodes to
 // the frame-changed pose, nothing blocks when nobody reads, and publish() allocates nothing.
-#include <gtest/gtest.h>
-
 #include <arpa/inet.h>
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -117,8 +116,7 @@ TEST(MavlinkEndpoint, RejectsBadSpecsWithClearMessages) {
     const Status st = parseMavlinkEndpoint(c.spec, &e);
     ASSERT_FALSE(st.ok()) << c.spec;
     EXPECT_NE(st.message().find(c.message_part), std::string::npos) << st.message();
-    EXPECT_NE(st.message().find(std::string("'") + c.spec + "'"), std::string::npos)
-        << st.message();
+    EXPECT_NE(st.message().find(std::string("'") + c.spec + "'"), std::string::npos) << st.message();
   }
 }
 
@@ -174,8 +172,7 @@ TEST(MavlinkSink, UdpRoundTripDecodesToFrameChangedPose) {
     EXPECT_EQ(f.length, 233);  // quality 80 is the last byte: nothing to truncate
     const OdometrySample s = sampleAt(k);
     const Eigen::Isometry3d T_lb = localBodyPose(s.T_world_cam, frames);
-    EXPECT_EQ(readU64(f.payload, at("time_usec")),
-              static_cast<uint64_t>(std::llround(s.timestamp_s * 1e6)));
+    EXPECT_EQ(readU64(f.payload, at("time_usec")), static_cast<uint64_t>(std::llround(s.timestamp_s * 1e6)));
     EXPECT_NEAR(readFloat(f.payload, at("x")), T_lb.translation().x(), 1e-6);
     EXPECT_NEAR(readFloat(f.payload, at("y")), T_lb.translation().y(), 1e-6);
     EXPECT_NEAR(readFloat(f.payload, at("z")), T_lb.translation().z(), 1e-6);
@@ -192,8 +189,7 @@ TEST(MavlinkSink, UdpRoundTripDecodesToFrameChangedPose) {
       // Velocity in the body frame from the previous pose (finite difference, body axes).
       const Eigen::Isometry3d T_prev = localBodyPose(sampleAt(k - 1).T_world_cam, frames);
       const double dt = 1.0 / 30.0;
-      const Eigen::Vector3d v =
-          T_lb.linear().transpose() * (T_lb.translation() - T_prev.translation()) / dt;
+      const Eigen::Vector3d v = T_lb.linear().transpose() * (T_lb.translation() - T_prev.translation()) / dt;
       const Eigen::Vector3d w = logSO3(T_prev.linear().transpose() * T_lb.linear()) / dt;
       EXPECT_NEAR(readFloat(f.payload, at("vx")), v.x(), 1e-4);
       EXPECT_NEAR(readFloat(f.payload, at("vy")), v.y(), 1e-4);
@@ -279,8 +275,7 @@ TEST(MavlinkSink, AbsentOrStalledReceiverNeverBlocks) {
     constexpr int kMessages = 20000;
     const auto start = std::chrono::steady_clock::now();
     for (int k = 0; k < kMessages; ++k) sink.publish(sampleAt(k % 30), k * kSecond / 30);
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     EXPECT_LT(seconds, 5.0);  // ~20k sendto calls; a blocking send would hang here
     const MavlinkStats& st = sink.stats();
     EXPECT_EQ(st.odometry_sent + st.heartbeats_sent + st.dropped,
@@ -361,8 +356,7 @@ TEST(MavlinkSink, SerialDropsWhenFullAndKeepsTheStreamFrameAligned) {
     (f.msgid == 331 ? odometry : heartbeats)++;
     pos += f.frame_size;
   }
-  EXPECT_EQ(odometry + heartbeats,
-            sink.stats().odometry_sent + sink.stats().heartbeats_sent);
+  EXPECT_EQ(odometry + heartbeats, sink.stats().odometry_sent + sink.stats().heartbeats_sent);
   EXPECT_EQ(sink.stats().bytes_sent, stream.size());
   ::close(master);
 }

@@ -14,8 +14,8 @@ namespace mavtest {
 // CRC-16/MCRF4XX one bit at a time: reflected polynomial 0x8408, init 0xFFFF.
 inline uint16_t crcBitwise(uint16_t crc, uint8_t byte) {
   crc ^= byte;
-  for (int bit = 0; bit < 8; ++bit) crc = (crc & 1u) ? static_cast<uint16_t>((crc >> 1) ^ 0x8408u)
-                                                     : static_cast<uint16_t>(crc >> 1);
+  for (int bit = 0; bit < 8; ++bit)
+    crc = (crc & 1u) ? static_cast<uint16_t>((crc >> 1) ^ 0x8408u) : static_cast<uint16_t>(crc >> 1);
   return crc;
 }
 inline uint16_t crcBitwise(uint16_t crc, const std::string& text) {
@@ -43,9 +43,8 @@ inline int typeSize(const std::string& type) {
 inline std::vector<FieldDef> wireOrder(const std::vector<FieldDef>& declared) {
   std::vector<FieldDef> base, ext;
   for (const FieldDef& f : declared) (f.extension ? ext : base).push_back(f);
-  std::stable_sort(base.begin(), base.end(), [](const FieldDef& a, const FieldDef& b) {
-    return typeSize(a.type) > typeSize(b.type);
-  });
+  std::stable_sort(base.begin(), base.end(),
+                   [](const FieldDef& a, const FieldDef& b) { return typeSize(a.type) > typeSize(b.type); });
   base.insert(base.end(), ext.begin(), ext.end());
   return base;
 }
@@ -82,8 +81,8 @@ inline uint8_t crcExtra(const std::string& message_name, const std::vector<Field
 
 // common.xml / minimal.xml, declaration order.
 inline std::vector<FieldDef> heartbeatDefinition() {
-  return {{"uint8_t", "type", 0, false},        {"uint8_t", "autopilot", 0, false},
-          {"uint8_t", "base_mode", 0, false},   {"uint32_t", "custom_mode", 0, false},
+  return {{"uint8_t", "type", 0, false},          {"uint8_t", "autopilot", 0, false},
+          {"uint8_t", "base_mode", 0, false},     {"uint32_t", "custom_mode", 0, false},
           {"uint8_t", "system_status", 0, false}, {"uint8_t", "mavlink_version", 0, false}};
 }
 
@@ -117,8 +116,7 @@ struct DecodedFrame {
 };
 
 // Parses one frame at data[0]; returns false if it is not a complete v2 frame.
-inline bool decodeFrame(const uint8_t* data, std::size_t size, uint8_t crc_extra,
-                        DecodedFrame* out) {
+inline bool decodeFrame(const uint8_t* data, std::size_t size, uint8_t crc_extra, DecodedFrame* out) {
   if (size < 12 || data[0] != 0xFD) return false;
   const std::size_t len = data[1];
   if (size < 12 + len) return false;

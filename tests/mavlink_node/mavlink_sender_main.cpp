@@ -61,11 +61,16 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (i + 1 >= argc) return usage(argv[0]);
-    if (arg == "--endpoint") endpoint = argv[++i];
-    else if (arg == "--frames") frames = std::atoi(argv[++i]);
-    else if (arg == "--rate-hz") rate_hz = std::atof(argv[++i]);
-    else if (arg == "--expected") expected_path = argv[++i];
-    else return usage(argv[0]);
+    if (arg == "--endpoint")
+      endpoint = argv[++i];
+    else if (arg == "--frames")
+      frames = std::atoi(argv[++i]);
+    else if (arg == "--rate-hz")
+      rate_hz = std::atof(argv[++i]);
+    else if (arg == "--expected")
+      expected_path = argv[++i];
+    else
+      return usage(argv[0]);
   }
   if (endpoint.empty() || frames <= 0) return usage(argv[0]);
 
@@ -108,10 +113,10 @@ int main(int argc, char** argv) {
     const plumb::MavlinkOdometry& m = sink.lastOdometry();
     const Eigen::Quaterniond q(sample.T_world_cam.linear());
     const Eigen::Vector3d& t = sample.T_world_cam.translation();
-    std::fprintf(expected, "%d %.17g %.17g %.17g %.17g %.17g %.17g %.17g", k, t.x(), t.y(), t.z(),
-                 q.w(), q.x(), q.y(), q.z());
+    std::fprintf(expected, "%d %.17g %.17g %.17g %.17g %.17g %.17g %.17g", k, t.x(), t.y(), t.z(), q.w(),
+                 q.x(), q.y(), q.z());
     std::fprintf(expected, " %" PRIu64, m.time_usec);
-    const float values[] = {m.x,  m.y,  m.z,  m.q[0], m.q[1],        m.q[2],         m.q[3],
+    const float values[] = {m.x,  m.y,  m.z,  m.q[0],      m.q[1],       m.q[2],    m.q[3],
                             m.vx, m.vy, m.vz, m.rollspeed, m.pitchspeed, m.yawspeed};
     for (float v : values) std::fprintf(expected, " %.9g", v);
     std::fprintf(expected, " %d %d", m.reset_counter, m.quality);
@@ -122,7 +127,6 @@ int main(int argc, char** argv) {
   const plumb::MavlinkStats& s = sink.stats();
   std::printf("plumb_mavlink_sender: %" PRIu64 " odometry, %" PRIu64 " heartbeats, %" PRIu64
               " dropped, %" PRIu64 " bytes, %" PRIu64 " frames without pose, %" PRIu64 " resets\n",
-              s.odometry_sent, s.heartbeats_sent, s.dropped, s.bytes_sent, s.skipped_no_pose,
-              s.resets);
+              s.odometry_sent, s.heartbeats_sent, s.dropped, s.bytes_sent, s.skipped_no_pose, s.resets);
   return 0;
 }
