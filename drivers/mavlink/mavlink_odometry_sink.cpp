@@ -142,6 +142,10 @@ void MavlinkOdometrySink::publish(const OdometrySample& sample, int64_t now_ns) 
     return;
   }
   buildOdometry(sample, &last_odometry_);
+  if (options_.hold_until_velocity_known && std::isnan(last_odometry_.vx)) {
+    ++stats_.skipped_unknown_velocity;
+    return;
+  }
   packOdometryPayload(last_odometry_, payload_);
   if (sendMessage(kMavlinkMsgIdOdometry, kMavlinkCrcExtraOdometry, payload_, kMavlinkOdometryPayloadBytes)) {
     ++stats_.odometry_sent;

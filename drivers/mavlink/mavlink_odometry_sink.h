@@ -38,6 +38,11 @@ struct MavlinkOptions {
   uint8_t frame_id = kMavFrameLocalFrd;
   uint8_t estimator_type = kMavEstimatorTypeVision;  // RGB-D odometry, no IMU
   double heartbeat_period_s = 1.0;                   // <= 0 disables the heartbeat
+  // The first pose after start, a reset or a lost stretch has no velocity (it needs two poses).
+  // true: that pose is not sent (counted in skipped_unknown_velocity), so every ODOMETRY carries a
+  // finite velocity; ArduPilot's ODOMETRY handler passes vx, vy, vz to its EKF without a NaN
+  // check. false: it is sent with NaN velocity and rates, as MAVLink allows (PX4 ignores them).
+  bool hold_until_velocity_known = true;
 };
 
 // One odometry result, as the frame loop has it.
@@ -56,8 +61,9 @@ struct MavlinkStats {
   uint64_t heartbeats_sent = 0;
   uint64_t dropped = 0;  // frames the transport could not take (would block / error)
   uint64_t bytes_sent = 0;
-  uint64_t skipped_no_pose = 0;  // samples with has_pose == false
-  uint64_t resets = 0;           // reset_counter increments
+  uint64_t skipped_no_pose = 0;           // samples with has_pose == false
+  uint64_t skipped_unknown_velocity = 0;  // held back by hold_until_velocity_known
+  uint64_t resets = 0;                    // reset_counter increments
 };
 
 class MavlinkOdometrySink {
@@ -75,7 +81,7 @@ class MavlinkOdometrySink {
   // the velocity history and the reset counter exactly as publish() does.
   void buildOdometry(const OdometrySample& sample, MavlinkOdometry* out);
 
-  // The ODOMETRY fields of the last sample with a pose (sent or dropped), e.g. to log them.
+  // The ODOMETRY fields of the last sample with a pose (sent, dropped or held), e.g. to log them.
   const MavlinkOdometry& lastOdometry() const { return last_odometry_; }
   const MavlinkStats& stats() const { return stats_; }
   const MavlinkOptions& options() const { return options_; }

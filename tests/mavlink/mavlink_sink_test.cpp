@@ -139,7 +139,9 @@ TEST(MavlinkSink, OpenReportsUnusableEndpoints) {
 TEST(MavlinkSink, UdpRoundTripDecodesToFrameChangedPose) {
   UdpReceiver rx;
   MavlinkOdometrySink sink;
-  ASSERT_TRUE(sink.open(udpOptions(rx.port)).ok());
+  MavlinkOptions options = udpOptions(rx.port);
+  options.hold_until_velocity_known = false;  // see the first pose's NaN velocity too
+  ASSERT_TRUE(sink.open(options).ok());
   const MavlinkFrameChange frames;  // the defaults the sink uses
   constexpr int kFrames = 5;
   for (int k = 0; k < kFrames; ++k) {
@@ -246,16 +248,19 @@ TEST(MavlinkSink, HeartbeatAtOneHertzResetCounterAndLostFrames) {
       ++heartbeats;
       continue;
     }
-    EXPECT_EQ(f.length, 232);  // trailing quality 0 truncated
+    EXPECT_EQ(f.length, 232);                            // trailing quality 0 truncated
+    EXPECT_FALSE(std::isnan(readFloat(f.payload, 36)));  // vx always known (held otherwise)
     const int reset = f.payload[230];
     EXPECT_GE(reset, last_reset);
     last_reset = reset;
     ++odometry;
   }
   EXPECT_EQ(heartbeats, 4);  // t = 0, 1, 2, 3 s
-  EXPECT_EQ(odometry, 100);
+  // 105 frames - 5 lost - 3 held (no velocity yet: frame 0, 45 after the gap + reset, 70 reset).
+  EXPECT_EQ(odometry, 97);
   EXPECT_EQ(last_reset, 2);
   EXPECT_EQ(sink.stats().skipped_no_pose, 5u);
+  EXPECT_EQ(sink.stats().skipped_unknown_velocity, 3u);
   EXPECT_EQ(sink.stats().resets, 2u);
 }
 
@@ -274,11 +279,12 @@ TEST(MavlinkSink, AbsentOrStalledReceiverNeverBlocks) {
     ASSERT_TRUE(sink.open(udpOptions(port)).ok());
     constexpr int kMessages = 20000;
     const auto start = std::chrono::steady_clock::now();
-    for (int k = 0; k < kMessages; ++k) sink.publish(sampleAt(k % 30), k * kSecond / 30);
+    for (int k = 0; k < kMessages; ++k) sink.publish(sampleAt(k), k * kSecond / 30);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     EXPECT_LT(seconds, 5.0);  // ~20k sendto calls; a blocking send would hang here
     const MavlinkStats& st = sink.stats();
-    EXPECT_EQ(st.odometry_sent + st.heartbeats_sent + st.dropped,
+    EXPECT_EQ(st.skipped_unknown_velocity, 1u);  // the first pose
+    EXPECT_EQ(st.odometry_sent + st.heartbeats_sent + st.dropped + st.skipped_unknown_velocity,
               static_cast<uint64_t>(kMessages) + (kMessages / 30 + 1))
         << "every message is either handed to the kernel or counted as dropped";
   }
@@ -334,7 +340,7 @@ TEST(MavlinkSink, SerialDropsWhenFullAndKeepsTheStreamFrameAligned) {
   const auto start = std::chrono::steady_clock::now();
   AllocationScope scope;
   constexpr int kMessages = 2000;
-  for (int k = 0; k < kMessages; ++k) sink.publish(sampleAt(k % 30), k * kSecond / 30);
+  for (int k = 0; k < kMessages; ++k) sink.publish(sampleAt(k), k * kSecond / 30);
   EXPECT_EQ(scope.count(), 0u);
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
   const MavlinkStats full = sink.stats();
@@ -343,7 +349,7 @@ TEST(MavlinkSink, SerialDropsWhenFullAndKeepsTheStreamFrameAligned) {
 
   // Drain, send once more (flushes any torn tail first), drain again: whole frames only.
   std::vector<uint8_t> stream = readAll(master);
-  sink.publish(sampleAt(7), (kMessages + 1) * kSecond / 30);
+  sink.publish(sampleAt(kMessages), kMessages * kSecond / 30);
   const std::vector<uint8_t> rest = readAll(master);
   stream.insert(stream.end(), rest.begin(), rest.end());
   std::size_t pos = 0;
