@@ -20,13 +20,15 @@ Status MavlinkOdometrySink::open(const MavlinkOptions& options) {
   if (options.frame_id != kMavFrameLocalFrd && options.frame_id != kMavFrameLocalNed) {
     return Status::Error("mavlink: frame_id must be MAV_FRAME_LOCAL_FRD (20) or LOCAL_NED (1)");
   }
-  if (!options.T_body_cam.linear().isUnitary(1e-6)) {
-    return Status::Error("mavlink: T_body_cam rotation is not orthonormal");
+  if (!options.T_body_cam.linear().isUnitary(1e-6) || options.T_body_cam.linear().determinant() < 0 ||
+      !options.T_local_world.linear().isUnitary(1e-6) || options.T_local_world.linear().determinant() < 0) {
+    return Status::Error(
+        "mavlink: T_body_cam and T_local_world need rotation matrices (orthonormal, det +1)");
   }
   PLUMB_RETURN_IF_ERROR(transport_.open(endpoint));
   options_ = options;
   frames_.T_body_cam = options.T_body_cam;
-  frames_.T_local_world = options.T_body_cam;  // local frame = body at the world origin
+  frames_.T_local_world = options.use_T_local_world ? options.T_local_world : options.T_body_cam;
   stats_ = MavlinkStats();
   sequence_ = 0;
   reset_counter_ = 0;

@@ -33,6 +33,11 @@ struct MavlinkOptions {
   uint8_t component_id = kMavCompIdVisualInertialOdometry;
   // Camera -> body (FRD). Default: forward-looking camera at the body origin.
   Eigen::Isometry3d T_body_cam = forwardCameraBodyFrdExtrinsic();
+  // plumb world -> MAVLink local frame. Default (use_T_local_world false): T_local_world =
+  // T_body_cam, i.e. the local frame is the body frame when the camera was at plumb's world origin
+  // (plumb's world is the first camera frame), so the vehicle starts at 0 facing +x.
+  bool use_T_local_world = false;
+  Eigen::Isometry3d T_local_world = Eigen::Isometry3d::Identity();
   // kMavFrameLocalFrd (default: heading is the vehicle's at start) or kMavFrameLocalNed (the user
   // asserts the vehicle started level and facing north, or the autopilot rotates the frame).
   uint8_t frame_id = kMavFrameLocalFrd;

@@ -136,6 +136,35 @@ TEST(MavlinkSink, OpenReportsUnusableEndpoints) {
   EXPECT_FALSE(sink.isOpen());
 }
 
+TEST(MavlinkSink, RejectsExtrinsicsThatAreNotRotations) {
+  UdpReceiver rx;
+  MavlinkOdometrySink sink;
+  MavlinkOptions o = udpOptions(rx.port);
+  o.T_body_cam.linear() = -o.T_body_cam.linear();  // a reflection: det -1
+  const Status st = sink.open(o);
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.message().find("T_body_cam"), std::string::npos);
+}
+
+TEST(MavlinkSink, ExplicitLocalFrameIsUsed) {
+  UdpReceiver rx;
+  MavlinkOdometrySink sink;
+  MavlinkOptions o = udpOptions(rx.port);
+  o.use_T_local_world = true;
+  o.T_local_world = forwardCameraBodyFrdExtrinsic();
+  o.T_local_world.translation() = Eigen::Vector3d(10, 20, -5);  // start at (10, 20, -5)
+  ASSERT_TRUE(sink.open(o).ok());
+  MavlinkOdometry m;
+  sink.buildOdometry(sampleAt(0), &m);
+  MavlinkFrameChange frames;
+  frames.T_local_world = o.T_local_world;
+  const Eigen::Vector3d p = localBodyPose(sampleAt(0).T_world_cam, frames).translation();
+  EXPECT_NEAR(m.x, p.x(), 1e-5);
+  EXPECT_NEAR(m.y, p.y(), 1e-5);
+  EXPECT_NEAR(m.z, p.z(), 1e-5);
+  EXPECT_NEAR(m.x, 10.0, 0.01);
+}
+
 TEST(MavlinkSink, UdpRoundTripDecodesToFrameChangedPose) {
   UdpReceiver rx;
   MavlinkOdometrySink sink;
