@@ -42,7 +42,8 @@ ALLOWED_LAYERS = {
     "pipeline/odometry": ["pipeline/frontend"] + _PIPE,
     "pipeline/loop": ["pipeline/odometry", "pipeline/frontend"] + _PIPE,
     "pipeline/run": ["pipeline/loop", "pipeline/odometry", "pipeline/frontend"] + _PIPE,
-    "drivers": ["sensor", "runtime", "platform"],
+    # solver/ for SE(3) maths only (output frame conventions, e.g. MAVLink's covariance).
+    "drivers": ["sensor", "solver", "runtime", "platform"],
     "tools": PRODUCT,
     "tests/support": PRODUCT,
     "tests/*": PRODUCT + ["tests/support"],
