@@ -42,6 +42,8 @@ void printRunUsage() {
       "  --progress           a progress line every 100 frames on stderr\n"
       "  --trace              one line per frame on stderr: matches, inliers, keyframe, pose\n"
       "  --count-allocations  print heap allocations per frame after a 30-frame warm-up\n"
+      "  --mavlink ENDPOINT   MAVLink v2 ODOMETRY + HEARTBEAT to an autopilot, as each pose is tracked:\n"
+      "                       udp:HOST:PORT or serial:DEVICE:BAUD (frames: docs/MAVLINK.md)\n"
       "schedule (capture -> extract -> track -> map, docs/RUNTIME.md):\n");
   std::printf("%s", scheduleUsage());
 }
@@ -67,7 +69,7 @@ Status writeTextFile(const std::string& path, const std::string& text) {
 int runRun(int argc, char** argv) {
   Args args(argc, argv,
             withScheduleFlags({"dataset", "camera", "out", "line-samples", "covariance", "stats", "max-frames",
-                               "gt", "output-delay", "rss-every"},
+                               "gt", "output-delay", "rss-every", "mavlink"},
                               scheduleValueFlags()),
             withScheduleFlags({"no-lines", "synth-noise", "progress", "trace", "count-allocations"},
                               scheduleSwitchFlags()));
@@ -133,6 +135,7 @@ int runRun(int argc, char** argv) {
   std::size_t expected = source->frameCount();
   if (max_frames > 0 && (expected == 0 || std::size_t(max_frames) < expected)) expected = std::size_t(max_frames);
   output_options.expected_frames = expected;
+  output_options.mavlink.endpoint = args.get("mavlink");
 
   RunOutputs outputs(output_options);
   RunRecord record;
@@ -184,6 +187,13 @@ int runRun(int argc, char** argv) {
                   (unsigned long long)record.run.allocation_frames,
                   double(record.run.allocations_after_warmup) / double(record.run.allocation_frames));
     }
+  }
+  if (const MavlinkOdometrySink* mavlink = outputs.mavlink()) {
+    const MavlinkStats& m = mavlink->stats();
+    std::printf("mavlink %s: odometry sent %llu, heartbeats %llu, dropped %llu, no pose %llu, resets %llu\n",
+                output_options.mavlink.endpoint.c_str(), (unsigned long long)m.odometry_sent,
+                (unsigned long long)m.heartbeats_sent, (unsigned long long)m.dropped,
+                (unsigned long long)m.skipped_no_pose, (unsigned long long)m.resets);
   }
   if (ate >= 0) std::printf("ATE RMSE %.4f m\n", ate);
   if (!profile_path.empty()) {

@@ -16,7 +16,26 @@ RunOutputs::RunOutputs(const RunOutputOptions& options) : options_(options), sta
 Status RunOutputs::open() {
   if (!options_.trajectory_path.empty()) PLUMB_RETURN_IF_ERROR(trajectory_writer_.open(options_.trajectory_path));
   if (!options_.covariance_path.empty()) PLUMB_RETURN_IF_ERROR(covariance_writer_.open(options_.covariance_path));
+  if (!options_.mavlink.endpoint.empty()) {
+    mavlink_ = std::make_unique<MavlinkOdometrySink>();
+    PLUMB_RETURN_IF_ERROR(mavlink_->open(options_.mavlink).withContext("--mavlink"));
+  }
   return Status::Ok();
+}
+
+void RunOutputs::onPose(const FrameOutput& out) {
+  if (!mavlink_) return;
+  OdometrySample sample;
+  sample.timestamp_s = out.timestamp_s;
+  sample.has_pose = out.has_pose;
+  sample.T_world_cam = out.T_world_cam;
+  // Quality from the tracking state: ok (enough inliers) 100, weak (pose kept, few inliers) 50.
+  sample.tracking_quality = out.state == TrackingState::kOk ? 100 : out.state == TrackingState::kWeak ? 50 : 0;
+  sample.has_covariance = out.has_pose && out.track.covariance_valid;
+  sample.covariance = out.track.covariance;
+  // The estimate jumps at a new map segment and at a relocalization: the autopilot must know.
+  sample.reset = out.new_map || out.relocalized;
+  mavlink_->publish(sample);
 }
 
 Status RunOutputs::close() {

@@ -3,10 +3,12 @@
 // produces: the TUM trajectory file, the keyframe covariance file, the poses kept in memory for the
 // ATE, statistics, and the --trace / --progress lines. Glue only: the formats live in
 // drivers/trajectory/, the statistics in pipeline/run/run_statistics.h.
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "drivers/common/frame_source.h"
+#include "drivers/mavlink/mavlink_odometry_sink.h"
 #include "drivers/trajectory/covariance_io.h"
 #include "drivers/trajectory/trajectory_io.h"
 #include "pipeline/run/odometry_run.h"
@@ -22,6 +24,8 @@ struct RunOutputOptions {
   long rss_every = 0;           // > 0: an RSS checkpoint every this many frames
   bool progress = false;        // a line per 100 frames on stderr
   bool trace = false;           // a line per frame on stderr (matches, inliers, keyframes, pose)
+  // MAVLink ODOMETRY to an autopilot (docs/MAVLINK.md): endpoint '' = off.
+  MavlinkOptions mavlink;
 };
 
 class RunOutputs final : public OdometrySink {
@@ -30,12 +34,14 @@ class RunOutputs final : public OdometrySink {
   Status open();   // the files
   Status close();  // flushes and closes them
 
+  void onPose(const FrameOutput& frame) override;
   Status onFrame(const FrameOutput& frame) override;
   Status onFinishedFrame(const FinishedFrame& frame) override;
   Status onRetiredKeyframe(const RetiredKeyframe& keyframe) override;
 
   const std::vector<StampedPose>& trajectory() const { return trajectory_; }
   const RunStatistics& statistics() const { return statistics_; }
+  const MavlinkOdometrySink* mavlink() const { return mavlink_.get(); }  // nullptr when off
 
  private:
   RunOutputOptions options_;
@@ -43,6 +49,7 @@ class RunOutputs final : public OdometrySink {
   CovarianceWriter covariance_writer_;
   std::vector<StampedPose> trajectory_;
   RunStatistics statistics_;
+  std::unique_ptr<MavlinkOdometrySink> mavlink_;
   uint64_t keyframes_ = 0, lost_ = 0;
 };
 

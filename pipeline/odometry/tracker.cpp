@@ -130,6 +130,8 @@ TrackResult Tracker::track(const FrameFeatures& input, uint64_t sequence, double
   if (result.frame_matches + result.local_map_matches >= 6) {
     const PoseResult pose = optimizeAndPrune(frame, T_cam_world, &result);
     T_cam_world = pose.T_cam_world;
+    result.covariance = pose.covariance;
+    result.covariance_valid = pose.covariance_valid;
   }
   const int inliers = result.point_inliers + result.line_inliers;
   if (inliers >= options_.tracker.min_inliers_ok) {

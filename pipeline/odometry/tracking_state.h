@@ -25,6 +25,11 @@ struct TrackResult {
   int landmark_inliers = 0;    // inliers that are map landmarks (not last-frame depth points)
   bool used_motion_fallback = false;  // constant velocity failed; wide / zero-motion retry used
   bool keyframe_requested = false;
+  // Covariance of the tracked pose from the final pose-only optimisation (inverse of its robust
+  // Gauss-Newton information): the 6x6 covariance of the left perturbation [rho; phi] of
+  // T_cam_world (solver/se3.h). Invalid when that optimisation did not run or was degenerate.
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  bool covariance_valid = false;
 };
 
 }  // namespace plumb

@@ -47,7 +47,7 @@ Status runOdometry(FrameCapture& capture, OdometrySystem& system, OdometrySink& 
   MapperFence fence(!lock_step && !simulated);
   CaptureStage capture_stage(capture, options.max_frames, options.stop, drops);
   ExtractStage extract(system);
-  TrackStage track(system, fence);
+  TrackStage track(system, fence, sink);
   MapStage map(system, fence, drops, sink, options.warmup_frames);
   runtime::StageRunner<OdometrySlot> runner(capture_stage, {&extract, &track, &map}, schedule);
   Status status = runner.run();

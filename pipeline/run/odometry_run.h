@@ -36,6 +36,10 @@ namespace plumb {
 class OdometrySink {
  public:
   virtual ~OdometrySink() = default;
+  // The pose of a frame as soon as tracking has it, on the TRACK stage's thread, in frame order
+  // (what a robot's controller wants, before mapping refines anything). Must not block: it is on
+  // the latency path. Not called for dropped frames.
+  virtual void onPose(const FrameOutput&) {}
   // Every frame after mapping (FrameOutput::dropped for a frame real-time mode dropped).
   virtual Status onFrame(const FrameOutput&) { return Status::Ok(); }
   // A frame whose output pose is final (pipeline/odometry/odometry_trajectory.h), oldest first:

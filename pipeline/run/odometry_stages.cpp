@@ -65,6 +65,7 @@ Status TrackStage::process(OdometrySlot& slot, const runtime::FrameStamps&) {
   system_.trackFeatures(*slot.features, slot.image.sequence, slot.image.timestamp_s, &fence_, slot.tracked.get());
   slot.tracked->output.extract_ms = slot.extract_ms;
   fence_.frameTracked();
+  sink_.onPose(slot.tracked->output);
   return Status::Ok();
 }
 

@@ -80,13 +80,15 @@ class ExtractStage final : public runtime::Stage<OdometrySlot> {
 // Stage 2: tracking and the keyframe decision; the keyframe request travels in the slot.
 class TrackStage final : public runtime::Stage<OdometrySlot> {
  public:
-  TrackStage(OdometrySystem& system, MapperFence& fence) : system_(system), fence_(fence) {}
+  TrackStage(OdometrySystem& system, MapperFence& fence, OdometrySink& sink)
+      : system_(system), fence_(fence), sink_(sink) {}
   const char* name() const override { return "track"; }
   Status process(OdometrySlot& slot, const runtime::FrameStamps&) override;
 
  private:
   OdometrySystem& system_;
   MapperFence& fence_;
+  OdometrySink& sink_;
 };
 
 // Stage 3: local mapping for keyframe requests, the output trajectory, the sink.
