@@ -62,6 +62,7 @@
 
 #include <Eigen/Core>
 
+#include "solver/outlier_thresholds.h"
 #include "solver/camera_intrinsics.h"
 #include "solver/robust_kernel.h"
 #include "solver/types.h"
@@ -78,9 +79,7 @@ struct LocalBaOptions {
   double kernel_delta_mono = 2.4477;    // sqrt(5.991)
   double kernel_delta_line = 1.9598;    // sqrt(3.841)
   // Chi-square thresholds for the outlier flags written after solve() (for map culling).
-  double chi2_stereo = 7.815;
-  double chi2_mono = 5.991;
-  double chi2_line = 3.841;
+  OutlierChi2 chi2;  // outlier thresholds by error dof (solver/outlier_thresholds.h)
   double initial_trust_radius = 1e4;  // lambda = 1 / radius
   double max_trust_radius = 1e16;
   double min_relative_decrease = 1e-3;  // accept a step when actual / predicted exceeds this
@@ -96,9 +95,9 @@ struct LocalBaOptions {
                                                           : kernel_delta_line};
   }
   double chi2ThresholdFor(ObservationKind kind) const {
-    return kind == ObservationKind::kStereoPoint ? chi2_stereo
-           : kind == ObservationKind::kMonoPoint ? chi2_mono
-                                                 : chi2_line;
+    return kind == ObservationKind::kStereoPoint ? chi2.stereo
+           : kind == ObservationKind::kMonoPoint ? chi2.mono
+                                                 : chi2.line;
   }
 };
 

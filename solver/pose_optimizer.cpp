@@ -185,14 +185,14 @@ int classify(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_cam_worl
   int changed = 0;
   double chi2 = 0.0;
   for (int i = 0; i < num_points; ++i) {
-    const double threshold = points[i].has_depth ? options.chi2_stereo : options.chi2_mono;
+    const double threshold = points[i].has_depth ? options.chi2.stereo : options.chi2.mono;
     const bool inlier = pointChi2(camera, T_cam_world, points[i], &chi2) && chi2 <= threshold;
     changed += inlier != point_inliers[i] ? 1 : 0;
     point_inliers[i] = inlier;
     result->num_point_inliers += inlier ? 1 : 0;
   }
   for (int i = 0; i < num_lines; ++i) {
-    const bool inlier = lineChi2(camera, T_cam_world, lines[i], &chi2) && chi2 <= options.chi2_line;
+    const bool inlier = lineChi2(camera, T_cam_world, lines[i], &chi2) && chi2 <= options.chi2.line;
     changed += inlier != line_inliers[i] ? 1 : 0;
     line_inliers[i] = inlier;
     result->num_line_inliers += inlier ? 1 : 0;

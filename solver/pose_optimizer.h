@@ -19,6 +19,7 @@
 // No heap allocation: inputs are caller arrays, inlier flags are written into caller buffers.
 #include <cmath>
 
+#include "solver/outlier_thresholds.h"
 #include "solver/camera_intrinsics.h"
 #include "solver/robust_kernel.h"
 #include "solver/types.h"
@@ -33,9 +34,7 @@ struct PoseOptimizerOptions {
   double kernel_delta_mono = std::sqrt(5.991);
   double kernel_delta_line = std::sqrt(3.841);
   // Chi-square thresholds (95%) separating inliers from outliers between rounds.
-  double chi2_stereo = 7.815;  // 3 dof
-  double chi2_mono = 5.991;    // 2 dof
-  double chi2_line = 3.841;    // 1 dof
+  OutlierChi2 chi2;  // outlier thresholds by error dof (solver/outlier_thresholds.h)
   int rounds = 4;                // ORB-SLAM2 uses 4 rounds ...
   int iterations_per_round = 10;  // ... of 10 iterations
   // Stop a round when |delta| (translation in m and rotation in rad together) is below this:

@@ -3,6 +3,7 @@
 // tools/ fills them from the command line; nothing inside pipeline/ reads configuration itself.
 #include <algorithm>
 
+#include "solver/outlier_thresholds.h"
 #include "pipeline/frontend/extractor_options.h"
 #include "pipeline/odometry/matcher.h"
 
@@ -24,9 +25,7 @@ struct TrackerOptions {
   // runs 4 rounds of 10 iterations with chi-square thresholds at 95%).
   int pose_rounds = 4;
   int pose_iterations_per_round = 10;
-  double chi2_stereo = 7.815;  // 3 dof, 95%
-  double chi2_mono = 5.991;    // 2 dof, 95%
-  double chi2_line = 3.841;    // 1 dof, 95%
+  OutlierChi2 chi2;  // outlier thresholds by error dof (solver/outlier_thresholds.h)
   // Landmarks farther than this (m) are not tracked (depth beyond it is too noisy to help).
   double max_landmark_distance_m = 8.0;
 };
@@ -47,9 +46,7 @@ struct LocalMapperOptions {
   int ba_fixed_keyframes = 6;        // keyframes outside the window observing its landmarks
   int ba_iterations = 5;             // Levenberg-Marquardt iterations per keyframe
   int max_ba_landmarks = 3000;       // points + line samples in one BA (extra ones are left out)
-  double chi2_stereo = 7.815;
-  double chi2_mono = 5.991;
-  double chi2_line = 3.841;
+  OutlierChi2 chi2;  // outlier thresholds by error dof (solver/outlier_thresholds.h)
   // New landmarks per keyframe (closest first, ORB-SLAM's RGB-D rule), and the depth range.
   int max_new_points = 400;
   int max_new_lines = 80;

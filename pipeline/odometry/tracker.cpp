@@ -37,9 +37,7 @@ Tracker::Tracker(const PinholeCamera& camera, const OdometryOptions& options)
       local_matcher_(withRadius(options.matcher, options.tracker.local_map_search_radius_px)),
       b_(std::make_unique<Buffers>()) {
   intrinsics_ = CameraIntrinsics{camera.fx, camera.fy, camera.cx, camera.cy, camera.fx * camera.baseline_m};
-  pose_options_.chi2_stereo = options.tracker.chi2_stereo;
-  pose_options_.chi2_mono = options.tracker.chi2_mono;
-  pose_options_.chi2_line = options.tracker.chi2_line;
+  pose_options_.chi2 = options.tracker.chi2;
   pose_options_.rounds = options.tracker.pose_rounds;
   pose_options_.iterations_per_round = options.tracker.pose_iterations_per_round;
   local_map_ = &b_->local_map;
