@@ -25,7 +25,7 @@ struct PinholeCamera {
   // Virtual baseline in metres for u_r = u - fx*b/d (ORB-SLAM2's RGB-D convention: 0.08 m).
   double baseline_m = 0.08;
   // Rolling shutter: seconds from the first to the last image row's exposure; 0 = global shutter.
-  // The tracker moves features to the middle row's time (pipeline/tracker_rolling_shutter.h).
+  // The tracker moves features to the middle row's time (pipeline/odometry/tracker_rolling_shutter.h).
   double rolling_shutter_readout_s = 0.0;
 
   bool hasDistortion() const { return k1 != 0 || k2 != 0 || p1 != 0 || p2 != 0 || k3 != 0; }

@@ -52,7 +52,7 @@ void printUsage() {
       "usage: plumb bench frontend --dataset DIR [--camera tum1] [--frames N] [--no-stock]\n"
       "                            [--line-level L] [--line-samples N] [--opencv-lsd] [--clock wall|cpu]\n"
       "                            [--dump FILE] [--repeat N]\n"
-      "  Runs the front end (pipeline/feature_extractor.h) with default ExtractorOptions on every\n"
+      "  Runs the front end (pipeline/frontend/feature_extractor.h) with default ExtractorOptions on every\n"
       "  frame of a TUM-layout folder, single thread, then the stock OpenCV path on the same frame.\n"
       "  --clock: what the two summary lines report: wall (steady clock, default) or cpu (this\n"
       "  thread's CPU time, which does not count waiting for a core on a loaded machine).\n"

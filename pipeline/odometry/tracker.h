@@ -3,7 +3,7 @@
 //
 //   0. rolling-shutter cameras (PinholeCamera::rolling_shutter_readout_s > 0): every feature is
 //      moved to the time of the frame's middle row with the constant-velocity motion
-//      (pipeline/tracker_rolling_shutter.h); the tracker, the map and local BA then see a
+//      (pipeline/odometry/tracker_rolling_shutter.h); the tracker, the map and local BA then see a
 //      global-shutter frame;
 //   1. predict with constant velocity; match the last frame's features by projection (points with
 //      depth or a landmark, lines with their 3D samples); too few matches -> retry with a wide

@@ -1,4 +1,4 @@
-// Rolling-shutter compensation (pipeline/tracker_rolling_shutter.h): features observed by a
+// Rolling-shutter compensation (pipeline/odometry/tracker_rolling_shutter.h): features observed by a
 // rolling-shutter camera turning fast are moved to where a global-shutter camera at the middle
 // row's time would have seen them.
 //
