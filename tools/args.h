@@ -18,6 +18,10 @@ class Args {
       if (a == "--help" || a == "-h") { help_ = true; continue; }
       if (a.rfind("--", 0) == 0) {
         std::string key = a.substr(2);
+        if (value_options.count(key) || flag_options.count(key)) {
+          // A repeated option is a mistake (which one was meant?), not "the last one wins".
+          if (values_.count(key) || flags_.count(key)) { error_ = "option --" + key + " given twice"; return; }
+        }
         if (value_options.count(key)) {
           if (i + 1 >= argc) { error_ = "option --" + key + " needs a value"; return; }
           values_[key] = argv[++i];

@@ -3,6 +3,8 @@
 // `# <timestamp> lost`, frames real-time mode dropped as `# <timestamp> dropped`), optionally
 // keyframe covariances and statistics, and the ATE when ground truth is at hand. Default mode:
 // deterministic (lock-step, one thread): same input -> same output bytes.
+#include <atomic>
+#include <csignal>
 #include <cstdio>
 #include <memory>
 #include <set>
@@ -11,9 +13,11 @@
 #include "drivers/open/open_source.h"
 #include "drivers/synth/synth_spec.h"
 #include "drivers/trajectory/evaluate.h"
+#include "drivers/common/atomic_file.h"
 #include "runtime/chrome_trace.h"
 #include "tools/args.h"
 #include "tools/command.h"
+#include "tools/io_plan.h"
 #include "tools/run_flags.h"
 #include "tools/run_outputs.h"
 
@@ -27,7 +31,9 @@ void printRunUsage() {
       "                       (textured, low_texture, fast_rotation)\n"
       "  --camera PRESET|FILE tum1 tum2 tum3 icl or a camera file (default: the folder's camera.txt or\n"
       "                       the sensor its name tells)\n"
-      "  --out FILE           trajectory, one line per frame (T_world_cam, TUM format)\n"
+      "  --out FILE           trajectory, one line per frame (T_world_cam, TUM format); required\n"
+      "                       unless --discard-trajectory\n"
+      "  --discard-trajectory run without writing the trajectory (statistics or ATE only)\n"
       "  --line-samples N     line-guidance points per line: 0 (points only) or 2..10 (default 5)\n"
       "  --no-lines           points only (lines are neither mapped nor used for tracking)\n"
       "  --covariance FILE    per keyframe: timestamp and the 21 upper-triangle entries of its 6x6\n"
@@ -44,6 +50,9 @@ void printRunUsage() {
       "  --count-allocations  print heap allocations per frame after a 30-frame warm-up\n"
       "  --mavlink ENDPOINT   MAVLink v2 ODOMETRY + HEARTBEAT to an autopilot, as each pose is tracked:\n"
       "                       udp:HOST:PORT or serial:DEVICE:BAUD (frames: docs/MAVLINK.md)\n"
+      "Outputs appear only when complete (written aside, renamed into place); an output that is an\n"
+      "input is refused before any work. SIGINT/SIGTERM stop the run cleanly: every pose computed so\n"
+      "far is written, the statistics say so, and the exit code is 3.\n"
       "schedule (capture -> extract -> track -> map, docs/RUNTIME.md):\n");
   std::printf("%s", scheduleUsage());
 }
@@ -53,17 +62,21 @@ std::set<std::string> withScheduleFlags(std::set<std::string> own, const std::se
   return own;
 }
 
-int fail(const std::string& message) {
+int fail(const std::string& message, int code = kExitFailed) {
   std::fprintf(stderr, "plumb run: %s\n", message.c_str());
-  return 1;
+  return code;
 }
 
-Status writeTextFile(const std::string& path, const std::string& text) {
-  std::FILE* f = std::fopen(path.c_str(), "w");
-  if (f == nullptr) return Status::Error(path + ": cannot open for writing");
-  const bool written = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-  if (std::fclose(f) != 0 || !written) return Status::Error(path + ": write failed");
-  return Status::Ok();
+// SIGINT / SIGTERM: the capture stops reading, the frames already read finish, and every pose
+// reaches the outputs. A second signal while stopping is the default action (the outputs' temporary
+// files are then left, never a partial file under an output's name).
+std::atomic<bool> g_stop_requested{false};
+volatile std::sig_atomic_t g_stop_signal = 0;
+
+void onStopSignal(int signal) {
+  g_stop_signal = signal;
+  g_stop_requested.store(true);
+  std::signal(signal, SIG_DFL);
 }
 
 int runRun(int argc, char** argv) {
@@ -71,7 +84,7 @@ int runRun(int argc, char** argv) {
             withScheduleFlags({"dataset", "camera", "out", "line-samples", "covariance", "stats", "max-frames",
                                "gt", "output-delay", "rss-every", "mavlink"},
                               scheduleValueFlags()),
-            withScheduleFlags({"no-lines", "synth-noise", "progress", "trace", "count-allocations"},
+            withScheduleFlags({"no-lines", "synth-noise", "progress", "trace", "count-allocations", "discard-trajectory"},
                               scheduleSwitchFlags()));
   if (args.help()) {
     printRunUsage();
@@ -90,7 +103,11 @@ int runRun(int argc, char** argv) {
   const long max_frames = args.getInt("max-frames", -1, &ok);
   const long output_delay = args.getInt("output-delay", 60, &ok);
   const long rss_every = args.getInt("rss-every", 0, &ok);
-  if (!ok) return fail("--line-samples, --max-frames, --output-delay and --rss-every take integers");
+  if (!ok) return fail("--line-samples, --max-frames, --output-delay and --rss-every take integers", kExitUsage);
+  if (!args.has("out") && !args.has("discard-trajectory")) {
+    return fail("--out FILE is required (or --discard-trajectory to run without keeping the poses)", kExitUsage);
+  }
+  if (args.has("out") && args.has("discard-trajectory")) return fail("--out and --discard-trajectory exclude each other", kExitUsage);
 
   // Options are checked where they are used (OdometrySystem::create, validate(OdometryRunOptions)):
   // an impossible value is refused there, with its message, before any frame is read.
@@ -98,15 +115,28 @@ int runRun(int argc, char** argv) {
   setLineSamples(int(line_samples), !args.has("no-lines"), &system_options.odometry);
   system_options.output_delay_frames = int(output_delay);
   Status st = validate(system_options);
-  if (!st.ok()) return fail(st.message());
+  if (!st.ok()) return fail(st.message(), kExitUsage);
   OdometryRunOptions run_options;
   std::string profile_path;
   st = parseScheduleFlags(args, &run_options, &profile_path);
-  if (!st.ok()) return fail(st.message());
+  if (!st.ok()) return fail(st.message(), kExitUsage);
   run_options.max_frames = max_frames;
   run_options.keep_trace = !profile_path.empty();
+  run_options.stop = &g_stop_requested;
   st = validate(run_options);
-  if (!st.ok()) return fail(st.message());
+  if (!st.ok()) return fail(st.message(), kExitUsage);
+
+  // Every output is checked against every input before any work.
+  IoPlan io;
+  io.addInput(args.get("dataset"));
+  io.addInput(args.get("gt"));
+  io.addInput(args.get("camera"));
+  io.addOutput("--out", args.get("out"));
+  io.addOutput("--covariance", args.get("covariance"));
+  io.addOutput("--stats", args.get("stats"));
+  io.addOutput("--profile", profile_path);
+  st = io.check();
+  if (!st.ok()) return fail(st.message(), kExitUsage);
 
   const std::string spec = args.get("dataset");
   std::unique_ptr<FrameSource> source;
@@ -139,8 +169,17 @@ int runRun(int argc, char** argv) {
 
   RunOutputs outputs(output_options);
   RunRecord record;
+  std::signal(SIGINT, onStopSignal);
+  std::signal(SIGTERM, onStopSignal);
   st = runToOutputs(*source, system_options, run_options, outputs, &record);
-  if (!st.ok()) return fail(st.message());
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+  // A failed run still wrote every pose it computed (the runner finishes the system whatever ended
+  // the run): say so, then fail.
+  if (!st.ok()) {
+    return fail(st.message() + " (" + std::to_string(outputs.statistics().frames()) +
+                " frames processed; their poses were written)");
+  }
   const RunStatistics& statistics = outputs.statistics();
 
   double ate = -1;
@@ -197,7 +236,7 @@ int runRun(int argc, char** argv) {
   }
   if (ate >= 0) std::printf("ATE RMSE %.4f m\n", ate);
   if (!profile_path.empty()) {
-    st = runtime::writeChromeTrace(profile_path, record.run.trace, report);
+    st = writeFileAtomically(profile_path, runtime::formatChromeTrace(record.run.trace, report));
     if (!st.ok()) return fail(st.message());
     std::printf("%s", runtime::formatRunReport(report).c_str());
     std::printf("trace: %s (open in ui.perfetto.dev; `plumb profile %s --png hist.png`)\n", profile_path.c_str(),
@@ -213,10 +252,16 @@ int runRun(int argc, char** argv) {
     summary.system_options = system_options;
     summary.run_options = run_options;
     summary.ate_rmse_m = ate;
-    st = writeTextFile(args.get("stats"), runSummaryJson(summary));
+    summary.stop_signal = record.run.stopped ? int(g_stop_signal) : 0;
+    st = writeFileAtomically(args.get("stats"), runSummaryJson(summary));
     if (!st.ok()) return fail(st.message());
   }
-  return 0;
+  if (record.run.stopped) {
+    std::fprintf(stderr, "plumb run: stopped by signal %d after %llu frames; every pose computed was written\n",
+                 int(g_stop_signal), (unsigned long long)outputs.statistics().frames());
+    return kExitStopped;
+  }
+  return kExitOk;
 }
 
 }  // namespace

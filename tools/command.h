@@ -10,6 +10,13 @@ namespace plumb::tools {
 
 using CommandFn = int (*)(int argc, char** argv);
 
+// Exit codes of every subcommand (docs/DATA_FORMATS.md, "Exit codes").
+constexpr int kExitOk = 0;
+constexpr int kExitFailed = 1;     // the work failed (bad input data, I/O error); message on stderr
+constexpr int kExitUsage = 2;      // the command line is wrong (unknown flag, value out of range)
+constexpr int kExitStopped = 3;    // stopped by SIGINT/SIGTERM: outputs are complete up to the stop
+constexpr int kExitInternal = 70;  // an internal error or out of memory (EX_SOFTWARE)
+
 struct Command {
   const char* name;
   const char* summary;

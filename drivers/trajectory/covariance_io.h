@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 
+#include "drivers/common/atomic_file.h"
 #include "platform/status.h"
 
 namespace plumb {
@@ -31,7 +32,7 @@ class CovarianceWriter {
 
  private:
   std::string path_;
-  std::FILE* file_ = nullptr;
+  AtomicFile file_;  // appears under path_ only when closed (complete)
 };
 
 }  // namespace plumb

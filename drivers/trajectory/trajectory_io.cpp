@@ -125,38 +125,30 @@ Status writeTumTrajectory(const std::string& path, const std::vector<StampedPose
   return writer.close();
 }
 
-TumTrajectoryWriter::~TumTrajectoryWriter() {
-  if (file_) std::fclose(file_);
-}
+TumTrajectoryWriter::~TumTrajectoryWriter() = default;  // an uncommitted file is abandoned
 
 Status TumTrajectoryWriter::open(const std::string& path) {
-  if (file_) return Status::Error(path_ + ": trajectory writer already open");
+  if (file_.isOpen()) return Status::Error(path_ + ": trajectory writer already open");
   path_ = path;
-  file_ = std::fopen(path.c_str(), "wb");
-  if (!file_) return Status::Error(path + ": cannot write trajectory (" + std::strerror(errno) + ")");
+  PLUMB_RETURN_IF_ERROR(file_.open(path));
   std::fputs(
       "# plumb trajectory: timestamp tx ty tz qx qy qz qw (T_world_cam); "
       "'# <timestamp> lost' = no pose\n",
-      file_);
+      file_.file());
   return Status::Ok();
 }
 
 Status TumTrajectoryWriter::append(const StampedPose& pose) {
-  if (!file_) return Status::Error("trajectory writer is not open");
+  if (!file_.isOpen()) return Status::Error("trajectory writer is not open");
   char line[kTumLineCapacity];
   formatTumLine(pose, line, sizeof(line));
-  if (std::fprintf(file_, "%s\n", line) < 0) return Status::Error(path_ + ": write failed");
+  if (std::fprintf(file_.file(), "%s\n", line) < 0) return Status::Error(path_ + ": write failed");
   return Status::Ok();
 }
 
-
 Status TumTrajectoryWriter::close() {
-  if (!file_) return Status::Ok();
-  const bool failed = std::ferror(file_) != 0;
-  const bool close_failed = std::fclose(file_) != 0;
-  file_ = nullptr;
-  if (failed || close_failed) return Status::Error(path_ + ": write failed");
-  return Status::Ok();
+  if (!file_.isOpen()) return Status::Ok();
+  return file_.commit();
 }
 
 }  // namespace plumb

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "drivers/common/atomic_file.h"
 #include "platform/status.h"
 
 namespace plumb {
@@ -68,7 +69,7 @@ class TumTrajectoryWriter {
 
  private:
   std::string path_;
-  std::FILE* file_ = nullptr;
+  AtomicFile file_;  // appears under path_ only when closed (complete)
 };
 
 }  // namespace plumb

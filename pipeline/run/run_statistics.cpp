@@ -73,9 +73,9 @@ std::string runSummaryJson(const RunSummary& r) {
   auto add = [&out, &buf](int n) { out.append(buf, std::size_t(std::max(0, std::min(n, int(sizeof(buf)) - 1)))); };
   out += "{\n  \"source\": " + jsonString(r.source) + ",\n";
   add(std::snprintf(buf, sizeof(buf), "  \"frames\": %" PRIu64 ", \"frames_dropped\": %" PRIu64
-                    ", \"extraction_failures\": %" PRIu64 ", \"stopped_by_request\": %s,\n",
+                    ", \"extraction_failures\": %" PRIu64 ",\n  \"stopped_by_signal\": %s, \"stop_signal\": %d,\n",
                     r.statistics->frames(), r.statistics->framesDropped(), r.run->extraction_failures,
-                    r.run->stopped ? "true" : "false"));
+                    r.run->stopped ? "true" : "false", r.stop_signal));
   add(std::snprintf(buf, sizeof(buf),
                     "  \"tracking\": {\"ok\": %" PRIu64 ", \"weak\": %" PRIu64 ", \"lost\": %" PRIu64
                     ", \"not_initialized\": %" PRIu64 ", \"motion_fallback\": %" PRIu64 "},\n",

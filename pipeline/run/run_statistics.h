@@ -54,6 +54,7 @@ struct RunSummary {
   SystemOptions system_options;
   OdometryRunOptions run_options;
   double ate_rmse_m = -1;
+  int stop_signal = 0;  // the signal that stopped the run early (0: it was not stopped by one)
 };
 std::string runSummaryJson(const RunSummary& summary);
 

@@ -3,7 +3,13 @@
 // lines" without a word).
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 #include "pipeline/odometry/odometry_system.h"
 #include "tests/support/plumb_cli.h"
@@ -67,6 +73,117 @@ TEST(RunCli, TwoLineSamplesTrackWithLines) {
   EXPECT_NE(json.find("\"line_samples\": 2, \"lines\": true, \"min_line_inliers\": 2"), std::string::npos) << json;
   // Lines were really made into landmarks with 2 samples each.
   EXPECT_EQ(json.find("\"lines_created\": 0,"), std::string::npos) << json;
+}
+
+}  // namespace
+}  // namespace plumb::test
+
+namespace plumb::test {
+namespace {
+
+std::string readAll(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// A small TUM-layout folder written by `plumb synth`, as a user's dataset.
+class RunDataSafety : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(dir_.ok());
+    dataset_ = dir_.file("ds");
+    const RunResult r = runPlumb("synth --preset textured --frames 12 --out '" + dataset_ + "'");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    ASSERT_TRUE(std::filesystem::exists(dataset_ + "/groundtruth.txt"));
+  }
+  ScratchDir dir_{"plumb_run_safety"};
+  std::string dataset_;
+};
+
+TEST_F(RunDataSafety, OutputEqualToGroundTruthIsRefusedAndTheGroundTruthSurvives) {
+  const std::string gt = dataset_ + "/groundtruth.txt";
+  const std::string before = readAll(gt);
+  const RunResult r = runPlumb("run --dataset '" + dataset_ + "' --out '" + gt + "' --gt '" + gt + "'");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("refusing to overwrite"), std::string::npos) << r.output;
+  EXPECT_EQ(readAll(gt), before);
+}
+
+TEST_F(RunDataSafety, OutputOverAFileOfTheInputFolderIsRefused) {
+  for (const std::string name : {"rgb.txt", "depth.txt", "camera.txt"}) {
+    const std::string victim = dataset_ + "/" + name;
+    const std::string before = readAll(victim);
+    ASSERT_FALSE(before.empty()) << name;
+    for (const std::string flag : {"--out", "--stats", "--covariance"}) {
+      std::string args = "run --dataset '" + dataset_ + "' " + flag + " '" + victim + "'";
+      if (flag != "--out") args += " --out '" + dir_.file("t.txt") + "'";
+      const RunResult r = runPlumb(args);
+      EXPECT_EQ(r.exit_code, 2) << flag << " " << name << ": " << r.output;
+      EXPECT_EQ(readAll(victim), before) << flag << " " << name;
+    }
+  }
+}
+
+TEST_F(RunDataSafety, BadOutputPathsAreRefusedBeforeAnyWork) {
+  const std::string out = dir_.file("t.txt");
+  for (const std::string extra : {"--stats /nonexistent/folder/s.json", "--profile /nonexistent/p.json",
+                                  "--covariance '" + dir_.file("") + "'"}) {
+    const RunResult r = runPlumb("run --dataset '" + dataset_ + "' --out '" + out + "' " + extra);
+    EXPECT_EQ(r.exit_code, 2) << extra << ": " << r.output;
+    EXPECT_FALSE(std::filesystem::exists(out)) << extra << ": the run started before the paths were checked";
+  }
+}
+
+TEST_F(RunDataSafety, MissingOutRepeatedFlagsAndNegativeCountsAreUsageErrors) {
+  EXPECT_EQ(runPlumb("run --dataset '" + dataset_ + "'").exit_code, 2);
+  EXPECT_EQ(runPlumb("run --dataset '" + dataset_ + "' --out a.txt --out b.txt").exit_code, 2);
+  EXPECT_EQ(runPlumb("run --dataset '" + dataset_ + "' --out '" + dir_.file("t.txt") + "' --max-frames -3").exit_code,
+            2);
+  EXPECT_FALSE(std::filesystem::exists(dir_.file("t.txt")));
+  const RunResult discard = runPlumb("run --dataset '" + dataset_ + "' --discard-trajectory --max-frames 3");
+  EXPECT_EQ(discard.exit_code, 0) << discard.output;
+}
+
+TEST_F(RunDataSafety, NoPartialFileUnderTheOutputNameAndNoLeftovers) {
+  const std::string out = dir_.file("t.txt");
+  const RunResult r = runPlumb("run --dataset '" + dataset_ + "' --out '" + out + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // One line per frame plus the header, and no temporary file left beside it.
+  const std::string text = readAll(out);
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 13) << text;
+  for (const auto& entry : std::filesystem::directory_iterator(dir_.file("")))
+    EXPECT_EQ(entry.path().filename().string().find(".partial"), std::string::npos) << entry.path();
+}
+
+TEST(RunStop, SigintKeepsEveryComputedPoseAndSaysSo) {
+  ScratchDir dir("plumb_run_stop");
+  ASSERT_TRUE(dir.ok());
+  const std::string out = dir.file("t.txt"), stats = dir.file("s.json");
+  // Long enough never to finish within the timeout on any machine.
+  const std::string command = "timeout -s INT 4 '" + kPlumbBinary +
+                              "' run --dataset synth:textured:1:100000 --out '" + out + "' --stats '" + stats +
+                              "' 2>&1";
+  std::FILE* pipe = ::popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string output;
+  char buffer[4096];
+  std::size_t n;
+  while ((n = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0) output.append(buffer, n);
+  const int status = ::pclose(pipe);
+  ASSERT_TRUE(WIFEXITED(status)) << output;
+  EXPECT_EQ(WEXITSTATUS(status), 3) << output;
+  const std::string text = readAll(out);
+  const std::string json = readAll(stats);
+  EXPECT_NE(json.find("\"stopped_by_signal\": true"), std::string::npos) << json;
+  // Every processed frame has its line (held-back poses included), and the last line is whole.
+  unsigned long long frames = 0;
+  const std::size_t at = json.find("\"frames\": ");
+  ASSERT_NE(at, std::string::npos) << json;
+  ASSERT_EQ(std::sscanf(json.c_str() + at, "\"frames\": %llu", &frames), 1);
+  EXPECT_GT(frames, 0u) << output;
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), long(frames) + 1) << output;
+  ASSERT_FALSE(text.empty());
+  EXPECT_EQ(text.back(), '\n');
 }
 
 }  // namespace
