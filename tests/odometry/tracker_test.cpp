@@ -75,16 +75,29 @@ TEST(Tracker, RecoversTheTruePoseOfTheNextFrameFromPoints) {
 TEST(Tracker, FollowsASequenceWithConstantVelocity) {
   // Five frames of the same motion: from the second on the velocity prediction is exact, and the
   // per-frame poses stay on the true trajectory (no drift with exact data).
-  const test::Scene scene = test::makeScene(2, 400, 0, kStart, 1.5, 5.0);
-  Fixture fx;
-  const test::View first = test::observe(scene, kStart);
-  fx.startMap(*first.features, 0, kStart);
-  Eigen::Isometry3d T_true = kStart;
+  // Started far from the world origin and turned: a velocity expressed in the wrong frame
+  // (world instead of camera) would predict centimetres off here.
+  const Eigen::Isometry3d start = pose(90, Eigen::Vector3d(1, 0, 0.1), Eigen::Vector3d(1.0, 2.0, -1.0));
+  const test::Scene scene = test::makeScene(2, 400, 0, start, 1.5, 5.0);
+  // A 3 px window: with exact data only an exact prediction finds the keypoints in it (the sparse
+  // scene's unique descriptors would forgive a poor prediction in the default 15 px window).
+  OdometryOptions options;
+  options.matcher.points.search_radius_px = 3;
+  Fixture fx(options);
+  const test::View first = test::observe(scene, start);
+  fx.startMap(*first.features, 0, start);
+  Eigen::Isometry3d T_true = start;
   for (int i = 1; i <= 5; ++i) {
     T_true = T_true * kStep;
     const test::View view = test::observe(scene, T_true);
     const TrackResult r = fx.tracker->track(*view.features, uint64_t(i), 0.1 * i, nullptr);
     ASSERT_NE(r.state, TrackingState::kLost) << "frame " << i;
+    if (i >= 2) {
+      // The velocity of the previous pair predicts this frame exactly: the normal window finds
+      // (nearly) every keypoint of the last frame, no fallback.
+      EXPECT_FALSE(r.used_motion_fallback) << "frame " << i;
+      EXPECT_GE(r.frame_matches, int(0.95 * double(view.features->keypoints.size()))) << "frame " << i;
+    }
     EXPECT_LT(translationError(r.T_world_cam, T_true), 2e-4) << "frame " << i;
     EXPECT_LT(rotationErrorDeg(r.T_world_cam, T_true), 2e-3) << "frame " << i;
   }
