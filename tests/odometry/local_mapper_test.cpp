@@ -23,14 +23,15 @@ const Eigen::Isometry3d kStart = pose(-8, Eigen::Vector3d(1, 0.5, 0), Eigen::Vec
 bool sameDescriptor(const Descriptor256& a, const Descriptor256& b) { return a.words == b.words; }
 
 // A keyframe request for `view` taken at T_world_cam, associated with `snapshot` by descriptor.
-// Keypoints listed in `skip` (by scene point index) are left unassociated.
+// Only the first `max_associated` keypoints are associated (the rest become new landmarks).
 std::unique_ptr<KeyframeRequest> trackedRequest(const test::View& view, const Eigen::Isometry3d& T_world_cam,
-                                                uint64_t sequence, const LocalMap& snapshot) {
+                                                uint64_t sequence, const LocalMap& snapshot,
+                                                std::size_t max_associated = kMaxKeypoints) {
   auto r = test::newMapRequest(view, T_world_cam, sequence);
   r->start_new_map = false;
   r->local_map_version = snapshot.version;
   const FrameFeatures& f = *view.features;
-  for (std::size_t k = 0; k < f.keypoints.size(); ++k) {
+  for (std::size_t k = 0; k < std::min(f.keypoints.size(), max_associated); ++k) {
     for (const LocalMapPoint& p : snapshot.points) {
       if (sameDescriptor(p.descriptor, f.keypoint_descriptors[k])) r->keypoint_landmark[k] = p.ref;
     }
@@ -189,11 +190,28 @@ TEST(LocalMapper, LocalBaHoldsTheFirstKeyframeAndPullsAPerturbedOneToTheTruth) {
   // The tracker's pose is 1 cm / 0.3 deg off; the observations are exact at the true pose.
   const Eigen::Isometry3d T_tracked = pose(0.3, Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0.006, -0.006, 0.005)) * T_true;
   const test::View view = test::observe(scene, T_true);
-  const auto request = trackedRequest(view, T_tracked, 1, fx.mapper->localMap());
-  ASSERT_EQ(associatedPoints(*request), int(view.features->keypoints.size()));
+  // 200 keypoints tie the keyframe to the map; the rest become new landmarks, placed from the
+  // tracker's (wrong) pose until BA moves them with the keyframe.
+  const auto request = trackedRequest(view, T_tracked, 1, fx.mapper->localMap(), 200);
+  ASSERT_EQ(associatedPoints(*request), 200);
   const InsertResult r = fx.mapper->insertKeyframe(*request);
   ASSERT_TRUE(r.inserted);
+  const int fresh = int(view.features->keypoints.size()) - 200;
+  ASSERT_GT(fresh, 50);
+  EXPECT_EQ(r.new_points, fresh);
   EXPECT_LT(r.ba_final_cost, 0.01 * r.ba_initial_cost);
+  int fresh_checked = 0;
+  for (const LocalMapPoint& p : fx.mapper->localMap().points) {
+    for (std::size_t k = 200; k < view.features->keypoints.size(); ++k) {
+      if (!sameDescriptor(p.descriptor, view.features->keypoint_descriptors[k])) continue;
+      ++fresh_checked;
+      const Eigen::Vector3d truth = scene.points[std::size_t(view.keypoint_point[k])].P_world;
+      EXPECT_LT((p.P_world - truth).norm(), 2e-3) << "new landmark of keypoint " << k;
+    }
+  }
+  // Each of those scene points has two landmarks now: the first keyframe's (exact) and the new
+  // one (as when a tracker misses a match); both must sit at the truth.
+  EXPECT_EQ(fresh_checked, 2 * fresh);
 
   const LocalMap& map = fx.mapper->localMap();
   ASSERT_EQ(map.keyframes.size(), 2u);
