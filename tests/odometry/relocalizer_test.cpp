@@ -29,11 +29,18 @@ struct Fixture {
 TEST(Relocalizer, ReobservedKeyframeGivesTheTruePose) {
   const test::Scene scene = test::makeScene(21, 300, 0, kKeyframe, 1.0, 4.0);
   Fixture fx;
-  // Two unrelated keyframes around the right one: the ranking must pick the right one.
+  // Unrelated keyframes, and decoys that share 40-100 descriptors with the scene in another
+  // geometry (enough to be candidates): the ranking must try the right keyframe first.
   fx.relocalizer->addKeyframe(1, Eigen::Isometry3d::Identity(), *test::unrelatedView(5, 300).features);
   fx.relocalizer->addKeyframe(2, kKeyframe, *test::observe(scene, kKeyframe).features);
   fx.relocalizer->addKeyframe(3, Eigen::Isometry3d::Identity(), *test::unrelatedView(6, 300).features);
-  EXPECT_EQ(fx.relocalizer->size(), 3u);
+  for (uint32_t d = 0; d < 6; ++d) {
+    test::Scene decoy = test::makeScene(100 + d, 200, 0, kKeyframe);
+    const std::size_t shared = 40 + 10 * d;
+    for (std::size_t i = 0; i < shared; ++i) decoy.points[i].descriptor = scene.points[(i * 7 + d) % 300].descriptor;
+    fx.relocalizer->addKeyframe(10 + d, kKeyframe, *test::observe(decoy, kKeyframe).features);
+  }
+  EXPECT_EQ(fx.relocalizer->size(), 9u);
 
   const Eigen::Isometry3d T_true = kKeyframe * kOffset;
   const test::View view = test::observe(scene, T_true);
@@ -42,8 +49,25 @@ TEST(Relocalizer, ReobservedKeyframeGivesTheTruePose) {
   const RelocResult r = fx.relocalizer->relocalize(*view.features, &T_world_cam);
   ASSERT_TRUE(r.success);
   EXPECT_EQ(r.keyframe_id, 2u);
+  EXPECT_EQ(r.candidates_tried, 1);
   EXPECT_GE(r.matches, int(view.features->keypoints.size()) - 5);
   EXPECT_GE(r.refined_inliers, r.matches - 5);
+  EXPECT_LT(translationError(T_world_cam, T_true), 1e-4);
+  EXPECT_LT(rotationErrorDeg(T_world_cam, T_true), 1e-3);
+}
+
+TEST(Relocalizer, KeyframeFarFromTheOriginAndTurned) {
+  // The pose is composed from the keyframe's world pose and the frame's pose relative to it: far
+  // from the origin and turned, any mix-up of the two is metres off.
+  const Eigen::Isometry3d T_keyframe = pose(130, Eigen::Vector3d(0.2, 1, -0.4), Eigen::Vector3d(6.0, -3.0, 4.0));
+  const test::Scene scene = test::makeScene(26, 300, 0, T_keyframe, 1.0, 4.0);
+  Fixture fx;
+  fx.relocalizer->addKeyframe(4, T_keyframe, *test::observe(scene, T_keyframe).features);
+  const Eigen::Isometry3d T_true = T_keyframe * kOffset;
+  Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
+  const RelocResult r = fx.relocalizer->relocalize(*test::observe(scene, T_true).features, &T_world_cam);
+  ASSERT_TRUE(r.success);
+  EXPECT_EQ(r.keyframe_id, 4u);
   EXPECT_LT(translationError(T_world_cam, T_true), 1e-4);
   EXPECT_LT(rotationErrorDeg(T_world_cam, T_true), 1e-3);
 }
