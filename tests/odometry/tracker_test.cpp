@@ -231,5 +231,49 @@ TEST(Tracker, KeyframeRequestNamesTheRightLandmarks) {
   for (const LandmarkVisibility& v : request->point_visibility) EXPECT_LE(v.found, v.visible);
 }
 
+TEST(Tracker, LastFrameFollowsTheCorrectionsOfANewSnapshot) {
+  // ORB-SLAM2's UpdateLastFrame: when local BA moved the last frame's reference keyframe, the
+  // last frame moves with it; when the last frame itself became the keyframe, it takes the
+  // keyframe's refined pose; a snapshot of another map segment moves nothing.
+  const test::Scene scene = test::makeScene(7, 300, 0, kStart);
+  const Eigen::Isometry3d T1 = kStart * kStep;
+  const Eigen::Isometry3d correction = pose(0.7, Eigen::Vector3d(1, 0.4, 0), Eigen::Vector3d(0.02, -0.01, 0.004));
+  auto snapshot = std::make_unique<LocalMap>();
+
+  for (int variant = 0; variant < 3; ++variant) {
+    Fixture fx;
+    fx.startMap(*test::observe(scene, kStart).features, 0, kStart);
+    const TrackResult r = fx.tracker->track(*test::observe(scene, T1).features, 1, 0.1, nullptr);
+    ASSERT_EQ(r.state, TrackingState::kOk);
+    *snapshot = fx.mapper->localMap();
+    ASSERT_EQ(snapshot->keyframes.size(), 1u);
+    snapshot->version += 1;
+    Eigen::Isometry3d expected;
+    if (variant == 0) {
+      // The reference keyframe (sequence 0) moved by `correction`.
+      snapshot->keyframes[0].T_world_cam = correction * kStart;
+      snapshot->T_world_reference = snapshot->keyframes[0].T_world_cam;
+      expected = correction * r.T_world_cam;
+    } else if (variant == 1) {
+      // The last frame (sequence 1) is the snapshot's reference keyframe, refined.
+      snapshot->reference_keyframe_sequence = 1;
+      snapshot->reference_keyframe_id = 2;
+      snapshot->T_world_reference = correction * T1;
+      (void)snapshot->keyframes.push_back(LocalMapKeyframe{2, snapshot->T_world_reference});
+      expected = correction * T1;
+    } else {
+      // Another segment: same keyframe id moved, but it is not the same map.
+      snapshot->segment += 1;
+      snapshot->keyframes[0].T_world_cam = correction * kStart;
+      expected = r.T_world_cam;
+    }
+    fx.tracker->setLocalMap(*snapshot);
+    EXPECT_LT(translationError(fx.tracker->lastPose(), expected), 1e-9) << "variant " << variant;
+    EXPECT_LT(rotationErrorDeg(fx.tracker->lastPose(), expected), 1e-7) << "variant " << variant;
+    // The correction is large enough to tell apart from no correction.
+    if (variant != 2) EXPECT_GT(translationError(expected, r.T_world_cam), 0.01);
+  }
+}
+
 }  // namespace
 }  // namespace plumb
