@@ -271,7 +271,9 @@ TEST(Tracker, LastFrameFollowsTheCorrectionsOfANewSnapshot) {
     EXPECT_LT(translationError(fx.tracker->lastPose(), expected), 1e-9) << "variant " << variant;
     EXPECT_LT(rotationErrorDeg(fx.tracker->lastPose(), expected), 1e-7) << "variant " << variant;
     // The correction is large enough to tell apart from no correction.
-    if (variant != 2) EXPECT_GT(translationError(expected, r.T_world_cam), 0.01);
+    if (variant != 2) {
+      EXPECT_GT(translationError(expected, r.T_world_cam), 0.01);
+    }
   }
 }
 
