@@ -64,9 +64,10 @@ struct PoseGraphOptions {
   double initial_trust_radius = 1e4;  // lambda = 1 / radius
   double max_trust_radius = 1e16;
   double min_relative_decrease = 1e-3;  // accept a step when actual / predicted exceeds this
-  // Converged when an accepted step lowers the cost by less than this fraction of it ...
+  // Converged when an accepted step lowers the cost by less than this fraction of it, or when
+  // the quadratic model predicts less than that for a computed step (accepted or not) ...
   double function_tolerance = 1e-12;
-  // ... or when its largest component is below this [m or rad] ...
+  // ... or when a computed step's largest component is below this [m or rad] ...
   double step_tolerance = 1e-12;
   // ... or when the largest gradient component at a linearisation is below this.
   double gradient_tolerance = 1e-14;
@@ -162,7 +163,19 @@ class PoseGraph {
     int row_position = 0;
     int col_position = 0;
   };
-  using Factorization = Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Upper, Eigen::NaturalOrdering<int>>;
+  // Eigen's sparse LDLT on the upper triangle, in the order analyze() chose (natural ordering
+  // here), with three allocation leaks of its public API closed from a subclass (found by counting
+  // malloc calls; Eigen allocates with malloc, which an operator-new hook does not see):
+  // factorize() constructs a temporary sparse matrix on every call even when it then reads the
+  // input directly, vectorD() returns D by value, and D is first sized inside the first
+  // factorisation. The protected numeric factorisation and D are used directly instead.
+  class Factorization
+      : public Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Upper, Eigen::NaturalOrdering<int>> {
+   public:
+    void reserveDiagonal(Eigen::Index size) { m_diag.resize(size); }
+    void factorizeOrdered(const Eigen::SparseMatrix<double>& H_upper) { factorize_preordered<true>(H_upper); }
+    const Eigen::VectorXd& diagonalD() const { return m_diag; }
+  };
 
   double edgeCost(const Edge& edge, const Eigen::Isometry3d& T_i, const Eigen::Isometry3d& T_j) const;
   double linearize();                      // fills H_ values, g_, diagonal_; returns the cost
@@ -188,7 +201,6 @@ class PoseGraph {
   Factorization factorization_;
   Eigen::VectorXd g_;                    // gradient, by position
   Eigen::VectorXd diagonal_;             // undamped diagonal of H
-  Eigen::VectorXd rhs_;                  // -g
   Eigen::VectorXd dx_;                   // step, by position
 };
 

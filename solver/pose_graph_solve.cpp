@@ -76,12 +76,15 @@ bool PoseGraph::solveDamped(double lambda) {
   const int* outer = H_.outerIndexPtr();
   double* values = H_.valuePtr();
   for (Eigen::Index c = 0; c < H_.cols(); ++c) values[outer[c + 1] - 1] = diagonal_[c] + damping(lambda, diagonal_[c]);
-  factorization_.factorize(H_);
+  factorization_.factorizeOrdered(H_);
   if (factorization_.info() != Eigen::Success) return false;
   // The damped H is positive definite in exact arithmetic; a non-positive pivot means rounding won.
-  if (!(factorization_.vectorD().minCoeff() > 0.0)) return false;
-  rhs_ = -g_;
-  dx_ = factorization_.solve(rhs_);
+  if (!(factorization_.diagonalD().minCoeff() > 0.0)) return false;
+  // L D L^T dx = -g, in place (Solve<> expressions evaluate through a temporary).
+  dx_ = -g_;
+  factorization_.matrixL().solveInPlace(dx_);
+  dx_.array() /= factorization_.diagonalD().array();
+  factorization_.matrixU().solveInPlace(dx_);
   return dx_.allFinite();
 }
 
@@ -140,6 +143,10 @@ PoseGraphSummary PoseGraph::optimize(const PoseGraphOptions& options) {
     }
     const double actual = cost - new_cost;
     const double step_quality = predicted > 0.0 ? actual / predicted : -1.0;
+    // At the minimum the actual change is rounding noise and steps get rejected forever; the
+    // model's own prediction (or a negligible step) says so first, accepted or not.
+    const bool nothing_left = step_ok && (predicted <= options.function_tolerance * cost ||
+                                          dx_.cwiseAbs().maxCoeff() < options.step_tolerance);
     if (step_ok && std::isfinite(new_cost) && step_quality > options.min_relative_decrease) {
       for (int n = 0; n < num_nodes_; ++n) nodes_[n].T_cam_world = nodes_[n].T_candidate;
       const double grow = 1.0 - std::pow(2.0 * step_quality - 1.0, 3);
@@ -149,11 +156,15 @@ PoseGraphSummary PoseGraph::optimize(const PoseGraphOptions& options) {
       relinearize = true;
       const double relative_change = actual / std::max(cost, 1e-300);
       cost = new_cost;
-      if (relative_change < options.function_tolerance || dx_.cwiseAbs().maxCoeff() < options.step_tolerance) {
+      if (nothing_left || relative_change < options.function_tolerance) {
         summary.status = PoseGraphStatus::kConverged;
         break;
       }
     } else {
+      if (nothing_left) {
+        summary.status = PoseGraphStatus::kConverged;
+        break;
+      }
       radius /= decrease_factor;
       decrease_factor *= 2.0;
     }

@@ -107,9 +107,9 @@ bool PoseGraph::analyze() {
   }
 
   factorization_.analyzePattern(H_);
+  factorization_.reserveDiagonal(dim);
   g_.resize(dim);
   diagonal_.resize(dim);
-  rhs_.resize(dim);
   dx_.resize(dim);
   structure_valid_ = factorization_.info() == Eigen::Success;
   return structure_valid_;
