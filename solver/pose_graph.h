@@ -45,8 +45,10 @@
 // what depends on the structure: the CSC arrays of H, the AMD ordering's work space, the symbolic
 // factor and the dense vectors of the current size. The LM iterations themselves (linearise,
 // factorise, solve, evaluate) allocate nothing for graphs of up to ~2,700 free nodes (beyond
-// that, Eigen puts the factorisation's work vectors, 3 x 6 x nodes, on the heap instead of the
-// stack). A second optimize() on an unchanged structure makes zero heap allocations (tested).
+// that, Eigen puts the factorisation's 6N-double work vector on the heap instead of the stack).
+// A second optimize() on an unchanged structure makes zero calls to malloc, which is what Eigen
+// allocates with (tests/solver/malloc replaces malloc to prove it; an operator-new hook would not
+// see Eigen's allocations).
 #include <cstdint>
 #include <vector>
 
