@@ -2,6 +2,7 @@
 #include "solver/pose_graph.h"
 
 #include <algorithm>
+
 #include <Eigen/Cholesky>
 
 #include "solver/se3.h"
@@ -40,11 +41,16 @@ Vector6d poseGraphEdgeError(const Eigen::Isometry3d& T_i_j, const Eigen::Isometr
 
 const char* toString(PoseGraphStatus status) {
   switch (status) {
-    case PoseGraphStatus::kConverged: return "converged";
-    case PoseGraphStatus::kMaxIterations: return "max_iterations";
-    case PoseGraphStatus::kNoVariables: return "no_variables";
-    case PoseGraphStatus::kNoFixedNode: return "no_fixed_node";
-    case PoseGraphStatus::kLinearSolverFailed: return "linear_solver_failed";
+    case PoseGraphStatus::kConverged:
+      return "converged";
+    case PoseGraphStatus::kMaxIterations:
+      return "max_iterations";
+    case PoseGraphStatus::kNoVariables:
+      return "no_variables";
+    case PoseGraphStatus::kNoFixedNode:
+      return "no_fixed_node";
+    case PoseGraphStatus::kLinearSolverFailed:
+      return "linear_solver_failed";
   }
   return "unknown";
 }
@@ -102,7 +108,8 @@ int PoseGraph::findNode(int64_t id) const {
   return -1;
 }
 
-double PoseGraph::edgeCost(const Edge& edge, const Eigen::Isometry3d& T_i, const Eigen::Isometry3d& T_j) const {
+double PoseGraph::edgeCost(const Edge& edge, const Eigen::Isometry3d& T_i,
+                           const Eigen::Isometry3d& T_j) const {
   const Vector6d e = poseGraphEdgeErrorFromInverse(edge.T_j_i, T_i, T_j, nullptr, nullptr);
   double rho = 0.0;
   double weight = 0.0;
@@ -130,8 +137,8 @@ double PoseGraph::candidateCost() const {
 
 double PoseGraph::edgeChi2(int edge_index) const {
   const Edge& edge = edges_[edge_index];
-  const Vector6d e =
-      poseGraphEdgeErrorFromInverse(edge.T_j_i, nodes_[edge.i].T_cam_world, nodes_[edge.j].T_cam_world, nullptr, nullptr);
+  const Vector6d e = poseGraphEdgeErrorFromInverse(edge.T_j_i, nodes_[edge.i].T_cam_world,
+                                                   nodes_[edge.j].T_cam_world, nullptr, nullptr);
   return e.dot(edge.information * e);
 }
 

@@ -62,7 +62,7 @@
 namespace plumb {
 
 struct PoseGraphOptions {
-  int max_iterations = 50;  // LM iterations (accepted and rejected steps both count)
+  int max_iterations = 50;            // LM iterations (accepted and rejected steps both count)
   double initial_trust_radius = 1e4;  // lambda = 1 / radius
   double max_trust_radius = 1e16;
   double min_relative_decrease = 1e-3;  // accept a step when actual / predicted exceeds this
@@ -91,7 +91,9 @@ struct PoseGraphSummary {
   int successful_steps = 0;
   double initial_cost = 0.0;
   double final_cost = 0.0;
-  bool ok() const { return status == PoseGraphStatus::kConverged || status == PoseGraphStatus::kMaxIterations; }
+  bool ok() const {
+    return status == PoseGraphStatus::kConverged || status == PoseGraphStatus::kMaxIterations;
+  }
 };
 
 // The edge error e = logSE3(T_i_j^-1 T_cam_i_world T_cam_j_world^-1) and its Jacobians with
@@ -139,8 +141,8 @@ class PoseGraph {
   const Eigen::Isometry3d& pose(int node) const { return nodes_[node].T_cam_world; }
   // Overwrite a pose (e.g. a new initial guess); the structure stays analysed.
   void setPose(int node, const Eigen::Isometry3d& T_cam_world) { nodes_[node].T_cam_world = T_cam_world; }
-  double cost() const;                 // 0.5 * sum rho(chi2) at the current poses
-  double edgeChi2(int edge) const;     // e^T Omega e at the current poses (e.g. to flag a false loop)
+  double cost() const;              // 0.5 * sum rho(chi2) at the current poses
+  double edgeChi2(int edge) const;  // e^T Omega e at the current poses (e.g. to flag a false loop)
 
  private:
   struct Node {
@@ -180,9 +182,9 @@ class PoseGraph {
   };
 
   double edgeCost(const Edge& edge, const Eigen::Isometry3d& T_i, const Eigen::Isometry3d& T_j) const;
-  double linearize();                      // fills H_ values, g_, diagonal_; returns the cost
+  double linearize();  // fills H_ values, g_, diagonal_; returns the cost
   void addToBlock(const Block& block, const Matrix6d& M, bool transpose);
-  bool solveDamped(double lambda);         // damped factorisation and step into dx_
+  bool solveDamped(double lambda);  // damped factorisation and step into dx_
   double modelCostReduction(double lambda) const;
   double candidateCost() const;
 
@@ -195,15 +197,15 @@ class PoseGraph {
 
   std::vector<Node> nodes_;
   std::vector<Edge> edges_;
-  std::vector<Block> blocks_;            // num_variables_ diagonal blocks, then off-diagonal ones
-  std::vector<int64_t> block_keys_;      // analyze() scratch: (col, row) pairs of off-diagonal blocks
-  std::vector<int> variable_node_;       // position -> node
+  std::vector<Block> blocks_;        // num_variables_ diagonal blocks, then off-diagonal ones
+  std::vector<int64_t> block_keys_;  // analyze() scratch: (col, row) pairs of off-diagonal blocks
+  std::vector<int> variable_node_;   // position -> node
 
-  Eigen::SparseMatrix<double> H_;        // upper triangle, damped in place per attempt
+  Eigen::SparseMatrix<double> H_;  // upper triangle, damped in place per attempt
   Factorization factorization_;
-  Eigen::VectorXd g_;                    // gradient, by position
-  Eigen::VectorXd diagonal_;             // undamped diagonal of H
-  Eigen::VectorXd dx_;                   // step, by position
+  Eigen::VectorXd g_;         // gradient, by position
+  Eigen::VectorXd diagonal_;  // undamped diagonal of H
+  Eigen::VectorXd dx_;        // step, by position
 };
 
 }  // namespace plumb

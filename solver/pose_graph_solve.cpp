@@ -38,7 +38,8 @@ double PoseGraph::linearize() {
     const Node& node_j = nodes_[edge.j];
     Matrix6d J_i;
     Matrix6d J_j;
-    const Vector6d e = poseGraphEdgeErrorFromInverse(edge.T_j_i, node_i.T_cam_world, node_j.T_cam_world, &J_i, &J_j);
+    const Vector6d e =
+        poseGraphEdgeErrorFromInverse(edge.T_j_i, node_i.T_cam_world, node_j.T_cam_world, &J_i, &J_j);
     const Vector6d Omega_e = edge.information * e;
     double rho = 0.0;
     double weight = 1.0;
@@ -68,14 +69,16 @@ double PoseGraph::linearize() {
   }
   const int* outer = H_.outerIndexPtr();
   const double* values = H_.valuePtr();
-  for (Eigen::Index c = 0; c < H_.cols(); ++c) diagonal_[c] = values[outer[c + 1] - 1];  // last row = diagonal
+  for (Eigen::Index c = 0; c < H_.cols(); ++c)
+    diagonal_[c] = values[outer[c + 1] - 1];  // last row = diagonal
   return cost;
 }
 
 bool PoseGraph::solveDamped(double lambda) {
   const int* outer = H_.outerIndexPtr();
   double* values = H_.valuePtr();
-  for (Eigen::Index c = 0; c < H_.cols(); ++c) values[outer[c + 1] - 1] = diagonal_[c] + damping(lambda, diagonal_[c]);
+  for (Eigen::Index c = 0; c < H_.cols(); ++c)
+    values[outer[c + 1] - 1] = diagonal_[c] + damping(lambda, diagonal_[c]);
   factorization_.factorizeOrdered(H_);
   if (factorization_.info() != Eigen::Success) return false;
   // The damped H is positive definite in exact arithmetic; a non-positive pivot means rounding won.
@@ -135,8 +138,9 @@ PoseGraphSummary PoseGraph::optimize(const PoseGraphOptions& options) {
     if (step_ok) {
       for (int n = 0; n < num_nodes_; ++n) {
         Node& node = nodes_[n];
-        node.T_candidate =
-            node.position >= 0 ? applyLeftIncrement(dx_.segment<6>(6 * node.position), node.T_cam_world) : node.T_cam_world;
+        node.T_candidate = node.position >= 0
+                               ? applyLeftIncrement(dx_.segment<6>(6 * node.position), node.T_cam_world)
+                               : node.T_cam_world;
       }
       new_cost = candidateCost();
       predicted = modelCostReduction(lambda);

@@ -2,6 +2,7 @@
 // Everything here depends only on which nodes are free and which pairs share an edge, so it runs
 // once per structure; this is the part of optimize() that allocates (see MEMORY in the header).
 #include <algorithm>
+
 #include <Eigen/OrderingMethods>
 
 #include "solver/pose_graph.h"
@@ -60,7 +61,8 @@ bool PoseGraph::analyze() {
     block_keys_[num_keys++] = blockKey(std::max(a, b), std::min(a, b));
   }
   std::sort(block_keys_.begin(), block_keys_.begin() + num_keys);
-  num_keys = static_cast<int>(std::unique(block_keys_.begin(), block_keys_.begin() + num_keys) - block_keys_.begin());
+  num_keys = static_cast<int>(std::unique(block_keys_.begin(), block_keys_.begin() + num_keys) -
+                              block_keys_.begin());
 
   // Scalar CSC pattern of the upper triangle. Column 6P + k holds, rows ascending, the six rows of
   // every off-diagonal block (Q, P), Q < P, then rows 6P .. 6P + k of the diagonal block.
@@ -102,8 +104,9 @@ bool PoseGraph::analyze() {
     if (a < 0 || b < 0) continue;
     const int64_t wanted = blockKey(std::max(a, b), std::min(a, b));
     edge.off_diagonal_block =
-        num_free + static_cast<int>(std::lower_bound(block_keys_.begin(), block_keys_.begin() + num_keys, wanted) -
-                                    block_keys_.begin());
+        num_free +
+        static_cast<int>(std::lower_bound(block_keys_.begin(), block_keys_.begin() + num_keys, wanted) -
+                         block_keys_.begin());
   }
 
   factorization_.analyzePattern(H_);

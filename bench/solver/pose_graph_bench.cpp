@@ -23,7 +23,8 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-double worstCentreError(const std::vector<Eigen::Isometry3d>& T, const std::vector<Eigen::Isometry3d>& T_true) {
+double worstCentreError(const std::vector<Eigen::Isometry3d>& T,
+                        const std::vector<Eigen::Isometry3d>& T_true) {
   double worst = 0.0;
   for (size_t k = 0; k < T.size(); ++k) {
     worst = std::max(worst, (T[k].inverse().translation() - T_true[k].inverse().translation()).norm());
@@ -36,7 +37,8 @@ double worstCentreError(const std::vector<Eigen::Isometry3d>& T, const std::vect
 int main() {
   using namespace plumb;
   using namespace plumb::testing;
-  std::printf("pose graph: chain + 10%% loop edges, noise 0.01 rad / 0.02 m, Huber(2) on loops, one fixed node\n");
+  std::printf(
+      "pose graph: chain + 10%% loop edges, noise 0.01 rad / 0.02 m, Huber(2) on loops, one fixed node\n");
   for (int nodes : {100, 500, 1000}) {
     PoseGraphProblemConfig config;
     config.seed = 7;
@@ -61,11 +63,13 @@ int main() {
     std::vector<Eigen::Isometry3d> T;
     for (int k = 0; k < nodes; ++k) T.push_back(graph.pose(k));
     const double per_iteration_ms = 1e3 * median(solve_s) / std::max(1, summary.iterations);
-    std::printf("nodes %4d edges %4d: analyze %.3f ms, optimize %.3f ms (%d iterations, %d accepted, %.3f ms/iteration, "
-                "%s), cost %.1f -> %.3f, worst centre error %.3f m -> %.3f m\n",
-                nodes, graph.numEdges(), 1e3 * median(analyze_s), 1e3 * median(solve_s), summary.iterations,
-                summary.successful_steps, per_iteration_ms, toString(summary.status), summary.initial_cost,
-                summary.final_cost, worstCentreError(p.T_initial, p.T_true), worstCentreError(T, p.T_true));
+    std::printf(
+        "nodes %4d edges %4d: analyze %.3f ms, optimize %.3f ms (%d iterations, %d accepted, %.3f "
+        "ms/iteration, "
+        "%s), cost %.1f -> %.3f, worst centre error %.3f m -> %.3f m\n",
+        nodes, graph.numEdges(), 1e3 * median(analyze_s), 1e3 * median(solve_s), summary.iterations,
+        summary.successful_steps, per_iteration_ms, toString(summary.status), summary.initial_cost,
+        summary.final_cost, worstCentreError(p.T_initial, p.T_true), worstCentreError(T, p.T_true));
   }
   return 0;
 }

@@ -18,12 +18,12 @@ namespace plumb::testing {
 struct PoseGraphProblemConfig {
   unsigned seed = 1;
   int num_nodes = 30;
-  int num_loops = 5;          // random loop edges between nodes at least 3 apart
-  int num_fixed = 1;          // the first nodes are fixed (at their true pose)
+  int num_loops = 5;                // random loop edges between nodes at least 3 apart
+  int num_fixed = 1;                // the first nodes are fixed (at their true pose)
   double sigma_rotation = 0.01;     // measurement noise [rad]
   double sigma_translation = 0.02;  // [m]
   bool huber_on_loops = false;
-  int num_parallel = 0;        // extra odometry edges duplicating (k, k+1) pairs
+  int num_parallel = 0;  // extra odometry edges duplicating (k, k+1) pairs
 };
 
 struct PoseGraphProblemEdge {
@@ -56,7 +56,8 @@ inline Matrix6d randomInformation(std::mt19937& rng, double sigma_translation, d
   for (int r = 0; r < 6; ++r)
     for (int c = 0; c < 6; ++c) M(r, c) = gauss(rng);
   Vector6d scale;
-  scale << Eigen::Vector3d::Constant(1.0 / sigma_translation), Eigen::Vector3d::Constant(1.0 / sigma_rotation);
+  scale << Eigen::Vector3d::Constant(1.0 / sigma_translation),
+      Eigen::Vector3d::Constant(1.0 / sigma_rotation);
   const Matrix6d correlated = M * M.transpose() / 6.0 + Matrix6d::Identity();
   return scale.asDiagonal() * correlated * scale.asDiagonal();
 }
@@ -107,15 +108,18 @@ inline PoseGraphProblem makePoseGraphProblem(const PoseGraphProblemConfig& confi
   return p;
 }
 
-inline void loadPoseGraph(const PoseGraphProblem& p, const std::vector<Eigen::Isometry3d>& poses, PoseGraph* graph) {
+inline void loadPoseGraph(const PoseGraphProblem& p, const std::vector<Eigen::Isometry3d>& poses,
+                          PoseGraph* graph) {
   graph->clear();
-  for (size_t k = 0; k < poses.size(); ++k) graph->addNode(static_cast<int64_t>(1000 + k), poses[k], p.fixed[k]);
+  for (size_t k = 0; k < poses.size(); ++k)
+    graph->addNode(static_cast<int64_t>(1000 + k), poses[k], p.fixed[k]);
   for (const PoseGraphProblemEdge& e : p.edges) graph->addEdge(e.i, e.j, e.T_i_j, e.information, e.kernel);
 }
 
 // ---- dense oracle ----
 
-inline Vector6d oracleEdgeError(const PoseGraphProblemEdge& e, const Eigen::Isometry3d& T_i, const Eigen::Isometry3d& T_j) {
+inline Vector6d oracleEdgeError(const PoseGraphProblemEdge& e, const Eigen::Isometry3d& T_i,
+                                const Eigen::Isometry3d& T_j) {
   return logSE3(e.T_i_j.inverse() * T_i * T_j.inverse());
 }
 
@@ -169,8 +173,12 @@ inline DenseOracleResult solveDenseOracle(const PoseGraphProblem& p, std::vector
       Eigen::Matrix<double, 6, 12> J;  // [d r / d delta_i | d r / d delta_j], central differences
       for (int c = 0; c < 6; ++c) {
         const Vector6d d = h * Vector6d::Unit(c);
-        J.col(c) = (oracleEdgeError(e, expSE3(d) * T[e.i], T[e.j]) - oracleEdgeError(e, expSE3(-d) * T[e.i], T[e.j])) / (2 * h);
-        J.col(6 + c) = (oracleEdgeError(e, T[e.i], expSE3(d) * T[e.j]) - oracleEdgeError(e, T[e.i], expSE3(-d) * T[e.j])) / (2 * h);
+        J.col(c) = (oracleEdgeError(e, expSE3(d) * T[e.i], T[e.j]) -
+                    oracleEdgeError(e, expSE3(-d) * T[e.i], T[e.j])) /
+                   (2 * h);
+        J.col(6 + c) = (oracleEdgeError(e, T[e.i], expSE3(d) * T[e.j]) -
+                        oracleEdgeError(e, T[e.i], expSE3(-d) * T[e.j])) /
+                       (2 * h);
       }
       const int idx[2] = {var[e.i], var[e.j]};
       for (int a = 0; a < 2; ++a) {

@@ -50,8 +50,12 @@ TEST(PoseGraph, EdgeJacobiansMatchCentralDifferences) {
     Matrix6d numeric_j;
     for (int c = 0; c < 6; ++c) {
       const Vector6d d = h * Vector6d::Unit(c);
-      numeric_i.col(c) = (poseGraphEdgeError(T_i_j, expSE3(d) * T_i, T_j) - poseGraphEdgeError(T_i_j, expSE3(-d) * T_i, T_j)) / (2 * h);
-      numeric_j.col(c) = (poseGraphEdgeError(T_i_j, T_i, expSE3(d) * T_j) - poseGraphEdgeError(T_i_j, T_i, expSE3(-d) * T_j)) / (2 * h);
+      numeric_i.col(c) = (poseGraphEdgeError(T_i_j, expSE3(d) * T_i, T_j) -
+                          poseGraphEdgeError(T_i_j, expSE3(-d) * T_i, T_j)) /
+                         (2 * h);
+      numeric_j.col(c) = (poseGraphEdgeError(T_i_j, T_i, expSE3(d) * T_j) -
+                          poseGraphEdgeError(T_i_j, T_i, expSE3(-d) * T_j)) /
+                         (2 * h);
     }
     EXPECT_LT((J_i - numeric_i).norm() / numeric_i.norm(), 1e-6) << "trial " << trial << " |e| " << e.norm();
     EXPECT_LT((J_j - numeric_j).norm() / numeric_j.norm(), 1e-6) << "trial " << trial << " |e| " << e.norm();
@@ -95,15 +99,17 @@ TEST(PoseGraph, RandomGraphsMatchTheDenseOracle) {
       worst_rotation = std::max(worst_rotation, rotationDifference(graph.pose(k), oracle.T[k]));
       worst_translation = std::max(worst_translation, translationDifference(graph.pose(k), oracle.T[k]));
     }
-    std::printf("seed %u: %d nodes, %d edges, cost %.4f -> %.6f (oracle %.6f), %d iterations; "
-                "worst difference to the oracle %.2e rad %.2e m\n",
-                c.seed, c.nodes, graph.numEdges(), summary.initial_cost, summary.final_cost, oracle.cost,
-                summary.iterations, worst_rotation, worst_translation);
+    std::printf(
+        "seed %u: %d nodes, %d edges, cost %.4f -> %.6f (oracle %.6f), %d iterations; "
+        "worst difference to the oracle %.2e rad %.2e m\n",
+        c.seed, c.nodes, graph.numEdges(), summary.initial_cost, summary.final_cost, oracle.cost,
+        summary.iterations, worst_rotation, worst_translation);
     EXPECT_LT(worst_rotation, 1e-6) << "seed " << c.seed;
     EXPECT_LT(worst_translation, 1e-6) << "seed " << c.seed;
     // Not trivially satisfied: the start was far from the optimum.
     double start_rotation = 0.0;
-    for (int k = 0; k < c.nodes; ++k) start_rotation = std::max(start_rotation, rotationDifference(p.T_initial[k], oracle.T[k]));
+    for (int k = 0; k < c.nodes; ++k)
+      start_rotation = std::max(start_rotation, rotationDifference(p.T_initial[k], oracle.T[k]));
     EXPECT_GT(start_rotation, 1e-3) << "seed " << c.seed;
   }
 }
@@ -255,7 +261,8 @@ TEST(PoseGraph, HuberKernelBoundsAFalseLoop) {
   double false_chi2 = 0.0;
   double loop_chi2 = 0.0;
   for (int robust = 0; robust < 2; ++robust) {
-    false_loop.kernel = robust ? RobustKernel{RobustKernelType::kHuber, 2.0} : RobustKernel{RobustKernelType::kNone, 1.0};
+    false_loop.kernel =
+        robust ? RobustKernel{RobustKernelType::kHuber, 2.0} : RobustKernel{RobustKernelType::kNone, 1.0};
     PoseGraphProblem q = p;
     q.edges.push_back(false_loop);
     PoseGraph graph(config.num_nodes, static_cast<int>(q.edges.size()));
@@ -269,8 +276,10 @@ TEST(PoseGraph, HuberKernelBoundsAFalseLoop) {
       loop_chi2 = graph.edgeChi2(graph.numEdges() - 2);
     }
   }
-  std::printf("false loop: worst centre error %.3f m without a kernel, %.4f m with Huber(2); chi2 false %.0f, true loop %.2f\n",
-              worst[0], worst[1], false_chi2, loop_chi2);
+  std::printf(
+      "false loop: worst centre error %.3f m without a kernel, %.4f m with Huber(2); chi2 false %.0f, true "
+      "loop %.2f\n",
+      worst[0], worst[1], false_chi2, loop_chi2);
   EXPECT_GT(worst[0], 0.3);   // least squares: bent
   EXPECT_LT(worst[1], 0.05);  // Huber: a few centimetres at most
   EXPECT_GT(false_chi2, 1e4);
@@ -312,11 +321,14 @@ TEST(PoseGraph, OptimizeMakesZeroAllocationsOnAnAnalysedStructure) {
   PoseGraphProblem q = p;
   q.edges.push_back(loop);
   q.edges.back().kernel = RobustKernel{RobustKernelType::kNone, 1.0};
-  EXPECT_NEAR(graph.cost(), oracleCost(q, [&] {
-    std::vector<Eigen::Isometry3d> T;
-    for (int k = 0; k < config.num_nodes; ++k) T.push_back(graph.pose(k));
-    return T;
-  }()), 1e-9 * graph.cost());
+  EXPECT_NEAR(graph.cost(),
+              oracleCost(q,
+                         [&] {
+                           std::vector<Eigen::Isometry3d> T;
+                           for (int k = 0; k < config.num_nodes; ++k) T.push_back(graph.pose(k));
+                           return T;
+                         }()),
+              1e-9 * graph.cost());
 }
 
 }  // namespace

@@ -60,7 +60,8 @@ TEST(Se3Jacobians, ClosedFormInverseIsTheInverse) {
       const double tolerance = 1e-12 * std::max(1.0, leftJacobianInverseSE3(xi).norm());
       EXPECT_LT((product - Matrix6d::Identity()).norm(), tolerance) << "angle " << angle;
       const Eigen::Vector3d phi = xi.tail<3>();
-      EXPECT_LT((leftJacobianSO3(phi) * leftJacobianInverseSO3(phi) - Eigen::Matrix3d::Identity()).norm(), tolerance);
+      EXPECT_LT((leftJacobianSO3(phi) * leftJacobianInverseSO3(phi) - Eigen::Matrix3d::Identity()).norm(),
+                tolerance);
     }
   }
 }

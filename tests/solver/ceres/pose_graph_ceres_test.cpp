@@ -2,13 +2,13 @@
 // with a different parametrisation (each free pose as a Euclidean 6-vector xi around its start,
 // T = expSE3(xi) T_start), numeric central-difference Jacobians, Ceres' own HuberLoss and its
 // dense solver. Same cost, so the same minimum. Built only when Ceres is found.
-#include <ceres/ceres.h>
-#include <gtest/gtest.h>
+#include <algorithm>
+#include <cstdio>
+#include <vector>
 
 #include <Eigen/Cholesky>
-#include <cstdio>
-#include <memory>
-#include <vector>
+#include <ceres/ceres.h>
+#include <gtest/gtest.h>
 
 #include "solver/pose_graph.h"
 #include "tests/solver/pose_graph_problem.h"
@@ -17,7 +17,8 @@ namespace plumb::testing {
 namespace {
 
 struct EdgeResidual {
-  EdgeResidual(const PoseGraphProblemEdge& edge, const Eigen::Isometry3d& start_i, const Eigen::Isometry3d& start_j)
+  EdgeResidual(const PoseGraphProblemEdge& edge, const Eigen::Isometry3d& start_i,
+               const Eigen::Isometry3d& start_j)
       : Z_inv(edge.T_i_j.inverse()), T_start_i(start_i), T_start_j(start_j) {
     sqrt_information = Eigen::LLT<Matrix6d>(edge.information).matrixU();  // Omega = U^T U
   }
@@ -83,8 +84,8 @@ TEST(PoseGraphCeres, RandomGraphsMatchCeres) {
       worst_rotation = std::max(worst_rotation, rotationDifference(graph.pose(k), T_ceres[k]));
       worst_translation = std::max(worst_translation, translationDifference(graph.pose(k), T_ceres[k]));
     }
-    std::printf("seed %u: cost ours %.9f ceres %.9f; worst difference %.2e rad %.2e m\n", seed, summary.final_cost,
-                ceres_cost, worst_rotation, worst_translation);
+    std::printf("seed %u: cost ours %.9f ceres %.9f; worst difference %.2e rad %.2e m\n", seed,
+                summary.final_cost, ceres_cost, worst_rotation, worst_translation);
     EXPECT_EQ(summary.status, PoseGraphStatus::kConverged);
     EXPECT_NEAR(summary.final_cost, ceres_cost, 1e-8 * ceres_cost);
     EXPECT_LT(worst_rotation, 1e-6);

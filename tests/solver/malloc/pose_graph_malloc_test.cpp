@@ -7,8 +7,8 @@
 #include <cstdlib>
 #include <vector>
 
-#include <Eigen/Core>
 #include <gtest/gtest.h>
+#include <Eigen/Core>
 
 #include "solver/pose_graph.h"
 #include "tests/solver/pose_graph_problem.h"
