@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "solver/pose_graph.h"
-#include "tests/solver/pose_graph_problem.h"
+#include "tests/support/pose_graph_problem.h"
 
 namespace {
 

@@ -12,7 +12,7 @@
 
 #include "platform/allocation_counter.h"
 #include "solver/se3.h"
-#include "tests/solver/pose_graph_problem.h"
+#include "tests/support/pose_graph_problem.h"
 
 namespace plumb::testing {
 namespace {

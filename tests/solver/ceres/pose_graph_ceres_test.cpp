@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "solver/pose_graph.h"
-#include "tests/solver/pose_graph_problem.h"
+#include "tests/support/pose_graph_problem.h"
 
 namespace plumb::testing {
 namespace {

@@ -11,7 +11,7 @@
 #include <Eigen/Core>
 
 #include "solver/pose_graph.h"
-#include "tests/solver/pose_graph_problem.h"
+#include "tests/support/pose_graph_problem.h"
 
 extern "C" void* __libc_malloc(size_t size);
 extern "C" void* __libc_calloc(size_t count, size_t size);
