@@ -8,6 +8,7 @@
 #include "drivers/recording/recording_writer.h"
 #include "drivers/recording/tum_folder_writer.h"
 #include "tools/args.h"
+#include "tools/io_plan.h"
 #include "tools/command.h"
 
 namespace {
@@ -98,6 +99,26 @@ int runConvert(int argc, char** argv) {
   const bool in_is_folder = std::filesystem::is_directory(in);
   const bool out_is_recording = out.size() > 9 && out.compare(out.size() - 9, 9, ".plumbrec") == 0;
   const bool in_is_recording = in.size() > 9 && in.compare(in.size() - 9, 9, ".plumbrec") == 0;
+  // Never write over the input (same file, or a file of the input folder) or into a folder that
+  // already holds a dataset.
+  if (out_is_recording) {
+    plumb::tools::IoPlan io;
+    io.addInput(in);
+    io.addInput(args.get("camera"));
+    io.addOutput("OUT", out);
+    const plumb::Status st = io.check();
+    if (!st.ok()) {
+      std::fprintf(stderr, "plumb convert: %s\n", st.message().c_str());
+      return 2;
+    }
+  } else {
+    std::error_code ec;
+    if (std::filesystem::exists(out, ec) && (!std::filesystem::is_directory(out, ec) || !std::filesystem::is_empty(out, ec))) {
+      std::fprintf(stderr, "plumb convert: OUT %s exists and is not an empty folder: refusing to write over it\n",
+                   out.c_str());
+      return 2;
+    }
+  }
   if (in_is_folder && out_is_recording) return folderToRecording(in, out, args.get("camera"));
   if (in_is_recording && !out_is_recording) return recordingToFolder(in, out, args.get("camera"));
   return fail("convert a folder to FILE.plumbrec, or FILE.plumbrec to a folder (got '" + in +

@@ -6,6 +6,7 @@
 #include "drivers/trajectory/evaluate.h"
 #include "drivers/trajectory/trajectory_io.h"
 #include "drivers/trajectory/trajectory_plot.h"
+#include "runtime/json_text.h"
 #include "tools/args.h"
 #include "tools/command.h"
 
@@ -29,28 +30,20 @@ Status readTrajectory(const char* role, const std::string& path, std::vector<Sta
 
 void printJson(const std::string& gt, const std::string& est, const AteResult& ate, const RpeResult* rpe,
                const std::string& plot) {
-  // Paths are printed verbatim apart from escaping the two characters JSON requires.
-  auto quoted = [](const std::string& s) {
-    std::string out = "\"";
-    for (char c : s) {
-      if (c == '"' || c == '\\') out += '\\';
-      out += c;
-    }
-    return out + "\"";
-  };
+  // Numbers that are not finite (e.g. an overflow on absurd input) print as null: valid JSON.
+  using runtime::jsonNumber;
+  const auto quoted = runtime::jsonString;
   std::printf("{\"ground_truth\": %s, \"estimate\": %s,\n", quoted(gt).c_str(), quoted(est).c_str());
   const ErrorStatistics& a = ate.translation_m;
-  std::printf(
-      " \"ate\": {\"pairs\": %zu, \"rmse_m\": %.6f, \"mean_m\": %.6f, \"median_m\": %.6f, "
-      "\"max_m\": %.6f},\n",
-      ate.pairs, a.rmse, a.mean, a.median, a.max);
+  std::printf(" \"ate\": {\"pairs\": %zu, \"rmse_m\": %s, \"mean_m\": %s, \"median_m\": %s, \"max_m\": %s},\n",
+              ate.pairs, jsonNumber(a.rmse).c_str(), jsonNumber(a.mean).c_str(), jsonNumber(a.median).c_str(),
+              jsonNumber(a.max).c_str());
   if (rpe) {
     std::printf(
-        " \"rpe\": {\"pairs\": %zu, \"delta_s\": 1.0, \"translation_rmse_m_per_s\": %.6f, "
-        "\"translation_mean_m_per_s\": %.6f, \"rotation_rmse_deg_per_s\": %.6f, "
-        "\"rotation_mean_deg_per_s\": %.6f}",
-        rpe->pairs, rpe->translation_m_per_s.rmse, rpe->translation_m_per_s.mean,
-        rpe->rotation_deg_per_s.rmse, rpe->rotation_deg_per_s.mean);
+        " \"rpe\": {\"pairs\": %zu, \"delta_s\": 1.0, \"translation_rmse_m_per_s\": %s, "
+        "\"translation_mean_m_per_s\": %s, \"rotation_rmse_deg_per_s\": %s, \"rotation_mean_deg_per_s\": %s}",
+        rpe->pairs, jsonNumber(rpe->translation_m_per_s.rmse).c_str(), jsonNumber(rpe->translation_m_per_s.mean).c_str(),
+        jsonNumber(rpe->rotation_deg_per_s.rmse).c_str(), jsonNumber(rpe->rotation_deg_per_s.mean).c_str());
   } else {
     std::printf(" \"rpe\": null");
   }

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "drivers/open/open_source.h"
+#include "tools/io_plan.h"
 #include "drivers/recording/recording_writer.h"
 #include "tools/args.h"
 #include "tools/command.h"
@@ -60,8 +61,19 @@ int runRecord(int argc, char** argv) {
     return 2;
   }
 
+  // The recording is written in place (crash-safe append, readable after a power cut), so it must
+  // never be one of the inputs: checked before anything is opened for writing.
+  plumb::tools::IoPlan io;
+  io.addInput(args.get("source"));
+  io.addInput(args.get("camera"));
+  io.addOutput("--out", args.get("out"));
+  plumb::Status st = io.check();
+  if (!st.ok()) {
+    std::fprintf(stderr, "plumb record: %s\n", st.message().c_str());
+    return 2;
+  }
   std::unique_ptr<plumb::FrameSource> source;
-  plumb::Status st = plumb::openFrameSource(args.get("source"), args.get("camera"), &source);
+  st = plumb::openFrameSource(args.get("source"), args.get("camera"), &source);
   if (!st.ok()) return fail(st.message());
   if (codec == "raw" || (codec == "auto" && source->isLive()))
     options.colour_codec = options.depth_codec = plumb::ImageCodec::kRaw;
@@ -105,6 +117,17 @@ int runRecord(int argc, char** argv) {
               g_stop_requested ? " (stopped by Ctrl-C)" : "");
   if (no_frame_results > 0)
     std::printf("source timeouts (no frame): %llu\n", static_cast<unsigned long long>(no_frame_results));
+  const plumb::SourceDamage damage = source->damage();
+  if (damage.any()) {
+    std::fprintf(stderr,
+                 "plumb record: WARNING: the input is damaged: %llu damaged region(s) skipped (%llu bytes), %llu "
+                 "bytes of incomplete tail, %s; last: %s. Frames in damaged regions are not in the recording.\n",
+                 static_cast<unsigned long long>(damage.regions_skipped),
+                 static_cast<unsigned long long>(damage.bytes_skipped),
+                 static_cast<unsigned long long>(damage.truncated_tail_bytes),
+                 damage.closed_properly ? "closed properly" : "not closed properly",
+                 damage.last.empty() ? "-" : damage.last.c_str());
+  }
   return exit_code;
 }
 

@@ -181,6 +181,16 @@ int runRun(int argc, char** argv) {
                 " frames processed; their poses were written)");
   }
   const RunStatistics& statistics = outputs.statistics();
+  const SourceDamage damage = source->damage();
+  if (damage.any()) {
+    std::fprintf(stderr,
+                 "plumb run: WARNING: the input is damaged: %llu damaged region(s) skipped (%llu bytes), %llu bytes "
+                 "of incomplete tail, %s; last: %s. Frames in damaged regions have no trajectory line.\n",
+                 (unsigned long long)damage.regions_skipped, (unsigned long long)damage.bytes_skipped,
+                 (unsigned long long)damage.truncated_tail_bytes,
+                 damage.closed_properly ? "closed properly" : "not closed properly",
+                 damage.last.empty() ? "-" : damage.last.c_str());
+  }
 
   double ate = -1;
   std::vector<StampedPose> ground_truth;
@@ -253,6 +263,8 @@ int runRun(int argc, char** argv) {
     summary.run_options = run_options;
     summary.ate_rmse_m = ate;
     summary.stop_signal = record.run.stopped ? int(g_stop_signal) : 0;
+    summary.damaged_regions = damage.regions_skipped;
+    summary.damage = damage.last;
     st = writeFileAtomically(args.get("stats"), runSummaryJson(summary));
     if (!st.ok()) return fail(st.message());
   }

@@ -1,5 +1,6 @@
 // plumb synth: write a seeded synthetic RGB-D scene in TUM layout (drivers/synth).
 #include <chrono>
+#include <filesystem>
 #include <cstdio>
 
 #include "drivers/synth/synthetic_scene.h"
@@ -78,8 +79,17 @@ int runSynth(int argc, char** argv) {
   }
   options.seed = static_cast<uint64_t>(seed);
 
+  // A dataset is never written over another: an existing folder must be empty.
+  const std::string out_dir = args.get("out");
+  std::error_code ec;
+  if (std::filesystem::exists(out_dir, ec) &&
+      (!std::filesystem::is_directory(out_dir, ec) || !std::filesystem::is_empty(out_dir, ec))) {
+    std::fprintf(stderr, "plumb synth: --out %s exists and is not an empty folder: refusing to write a dataset over it\n",
+                 out_dir.c_str());
+    return 2;
+  }
   const auto start = std::chrono::steady_clock::now();
-  const plumb::Status status = plumb::writeSynthDataset(options, args.get("out"));
+  const plumb::Status status = plumb::writeSynthDataset(options, out_dir);
   if (!status.ok()) {
     std::fprintf(stderr, "plumb: %s\n", status.message().c_str());  // messages name "synth:" or the file
     return 1;

@@ -2,6 +2,7 @@
 // FrameSource: the one interface every producer of RGB-D frames implements — dataset replay,
 // synthetic scenes, our recordings, OpenNI2, V4L2. The pipeline's capture stage only sees this.
 #include <cstddef>
+#include <cstdint>
 #include <string>
 
 #include "sensor/camera.h"
@@ -15,6 +16,17 @@ enum class SourceResult {
   kEndOfStream,  // a finite source is exhausted (clean end)
   kNoFrame,      // a live source had nothing this time (timeout); try again
   kError,        // see lastError(); a live source may recover after reopen()
+};
+
+// Damage a source found and skipped (a recording's corrupt chunks, a cut tail). Counted and
+// reported by every command that reads a source: nothing is skipped silently.
+struct SourceDamage {
+  uint64_t regions_skipped = 0;      // damaged regions (each may have held a frame)
+  uint64_t bytes_skipped = 0;
+  uint64_t truncated_tail_bytes = 0;  // an incomplete last write (power cut)
+  bool closed_properly = true;       // the writer finished the file
+  std::string last;                  // the last damage, e.g. "chunk at byte 1234: CRC mismatch"
+  bool any() const { return regions_skipped > 0 || truncated_tail_bytes > 0 || !closed_properly; }
 };
 
 class FrameSource {
@@ -32,6 +44,8 @@ class FrameSource {
   // Frames a finite source will deliver, when known in advance (a dataset folder, a synthetic
   // scene); 0 when unknown (live sensors, recordings). Lets callers reserve memory once.
   virtual std::size_t frameCount() const { return 0; }
+  // What the source skipped so far (see SourceDamage); none for sources that cannot be damaged.
+  virtual SourceDamage damage() const { return SourceDamage{}; }
 };
 
 }  // namespace plumb

@@ -1,5 +1,7 @@
 #include "drivers/recording/recording_source.h"
 
+#include <cmath>
+
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
@@ -49,7 +51,18 @@ RecordingSource::~RecordingSource() {
 void RecordingSource::rewind() {
   pos_ = kFileHeaderSize;
   stats_ = RecordingStats();
+  has_last_timestamp_ = false;
   last_error_ = Status::Ok();
+}
+
+SourceDamage RecordingSource::damage() const {
+  SourceDamage d;
+  d.regions_skipped = stats_.chunks_skipped;
+  d.bytes_skipped = stats_.bytes_skipped;
+  d.truncated_tail_bytes = stats_.truncated_tail_bytes;
+  d.closed_properly = stats_.end_chunk_seen;
+  d.last = stats_.last_damage;
+  return d;
 }
 
 Status RecordingSource::overrideCamera(const PinholeCamera& camera) {
@@ -115,10 +128,11 @@ SourceResult RecordingSource::next(RgbdImage& out) {
     }
     const uint64_t chunk_size = kChunkHeaderSize + header.payload_size + kChunkCrcSize;
     if (chunk_size > file_size_ - pos_) {
-      // A valid header whose chunk runs past the end: the write was cut off.
-      stats_.truncated_tail_bytes += file_size_ - pos_;
-      pos_ = file_size_;
-      break;
+      // A header whose chunk runs past the end: the write was cut off -- unless a valid chunk
+      // follows, in which case the header's size field is damaged (e.g. a flipped bit claiming
+      // 256 MiB) and the later frames are still there.
+      skipDamage("chunk size runs past the end of the file");
+      continue;
     }
     chunk_.resize(chunk_size);
     if (readAt(pos_, chunk_.data(), chunk_size) != chunk_size) {
@@ -152,7 +166,7 @@ SourceResult RecordingSource::next(RgbdImage& out) {
       // CRC held, so the bytes are as written: a foreign or buggy writer. Skip and say so.
       ++stats_.chunks_skipped;
       stats_.bytes_skipped += chunk_size;
-      stats_.last_damage = "chunk at byte " + std::to_string(pos_) + ": undecodable frame";
+      stats_.last_damage = "chunk at byte " + std::to_string(pos_) + ": undecodable frame (bad image, size or timestamp)";
       pos_ += chunk_size;
       continue;
     }
@@ -166,11 +180,19 @@ SourceResult RecordingSource::next(RgbdImage& out) {
 bool RecordingSource::decodeFrame(const FrameChunkInfo& info, const uint8_t* images,
                                   RgbdImage& out) {
   if (info.width != camera_.width || info.height != camera_.height) return false;
+  // Time must be a number and move forward: a NaN, backwards or repeated timestamp (CRC intact, so
+  // a foreign or buggy writer) would put a wrong line into every trajectory made from this file.
+  if (!std::isfinite(info.timestamp_s) || !std::isfinite(info.depth_timestamp_s) ||
+      (has_last_timestamp_ && !(info.timestamp_s > last_timestamp_s_))) {
+    return false;
+  }
   if (!decodeColour(images, info.colour_size, info.colour_codec, info.width, info.height, out.bgr))
     return false;
   if (!decodeDepth(images + info.colour_size, info.depth_size, info.depth_codec, info.width,
                    info.height, out.depth_raw))
     return false;
+  has_last_timestamp_ = true;
+  last_timestamp_s_ = info.timestamp_s;
   out.sequence = info.sequence;
   out.timestamp_s = info.timestamp_s;
   out.depth_timestamp_s = info.depth_timestamp_s;

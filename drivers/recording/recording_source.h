@@ -39,6 +39,7 @@ class RecordingSource : public FrameSource {
   const Status& lastError() const override { return last_error_; }
 
   const RecordingStats& stats() const { return stats_; }
+  SourceDamage damage() const override;
   void rewind();
   // Replaces the recorded intrinsics (e.g. a later calibration). The image size must match.
   Status overrideCamera(const PinholeCamera& camera);
@@ -58,6 +59,8 @@ class RecordingSource : public FrameSource {
   uint64_t pos_ = 0;  // offset of the next chunk
   PinholeCamera camera_;
   RecordingStats stats_;
+  bool has_last_timestamp_ = false;
+  double last_timestamp_s_ = 0;  // of the last frame delivered: time must increase
   Status last_error_;
   std::vector<uint8_t> chunk_;  // reused: the current chunk's bytes
   std::vector<uint8_t> scan_;   // reused: resynchronisation window

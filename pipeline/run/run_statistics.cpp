@@ -7,6 +7,7 @@
 
 #include "pipeline/odometry/map_capacities.h"
 #include "platform/process_memory.h"
+#include "runtime/json_text.h"
 
 namespace plumb {
 
@@ -33,38 +34,10 @@ void RunStatistics::add(const FrameOutput& frame) {
   }
 }
 
-namespace {
-
-// A JSON string literal (quotes, backslashes and control characters escaped).
-std::string jsonString(const std::string& text) {
-  std::string out = "\"";
-  for (const char ch : text) {
-    const auto c = static_cast<unsigned char>(ch);
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += ch;
-    } else if (c < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof(buf), "\\u%04x", c);
-      out += buf;
-    } else {
-      out += ch;
-    }
-  }
-  return out + "\"";
-}
-
-// A finite number, or null (JSON has no inf/nan).
-std::string jsonNumber(double value, const char* format = "%.6f") {
-  if (!std::isfinite(value)) return "null";
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), format, value);
-  return buf;
-}
-
-}  // namespace
 
 std::string runSummaryJson(const RunSummary& r) {
+  using runtime::jsonNumber;
+  using runtime::jsonString;
   const OdometryStats& s = r.odometry;
   const MapperStats& m = r.mapper;
   const OdometryOptions& o = r.system_options.odometry;
@@ -76,6 +49,8 @@ std::string runSummaryJson(const RunSummary& r) {
                     ", \"extraction_failures\": %" PRIu64 ",\n  \"stopped_by_signal\": %s, \"stop_signal\": %d,\n",
                     r.statistics->frames(), r.statistics->framesDropped(), r.run->extraction_failures,
                     r.run->stopped ? "true" : "false", r.stop_signal));
+  add(std::snprintf(buf, sizeof(buf), "  \"input_damaged_regions\": %" PRIu64 ", \"input_damage\": ", r.damaged_regions));
+  out += (r.damage.empty() ? std::string("null") : jsonString(r.damage)) + ",\n";
   add(std::snprintf(buf, sizeof(buf),
                     "  \"tracking\": {\"ok\": %" PRIu64 ", \"weak\": %" PRIu64 ", \"lost\": %" PRIu64
                     ", \"not_initialized\": %" PRIu64 ", \"motion_fallback\": %" PRIu64 "},\n",

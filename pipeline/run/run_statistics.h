@@ -55,6 +55,8 @@ struct RunSummary {
   OdometryRunOptions run_options;
   double ate_rmse_m = -1;
   int stop_signal = 0;  // the signal that stopped the run early (0: it was not stopped by one)
+  uint64_t damaged_regions = 0;  // input regions the source skipped as damaged
+  std::string damage;            // the last damage it reported
 };
 std::string runSummaryJson(const RunSummary& summary);
 
