@@ -39,10 +39,8 @@ Status validate(const SystemOptions& options) {
 Status OdometrySystem::create(const PinholeCamera& camera, const SystemOptions& options,
                               std::unique_ptr<OdometrySystem>* out) {
   PLUMB_RETURN_IF_ERROR(validate(options));
-  if (!(camera.width > 0 && camera.height > 0 && std::isfinite(camera.fx) && std::isfinite(camera.fy) &&
-        camera.fx != 0 && camera.fy != 0)) {
-    return Status::Error("camera: needs a positive image size and finite, non-zero focal lengths");
-  }
+  const std::string camera_problem = camera.validate();
+  if (!camera_problem.empty()) return Status::Error("camera: " + camera_problem);
   out->reset(new OdometrySystem(camera, options));
   return Status::Ok();
 }

@@ -3,11 +3,15 @@
 // never yields a frame that differs from what was written.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <iterator>
 #include <map>
 #include <random>
 
+#include "drivers/recording/byte_io.h"
+#include "drivers/recording/crc32.h"
+#include "drivers/recording/recording_format.h"
 #include "drivers/recording/recording_source.h"
 #include "drivers/recording/recording_writer.h"
 #include "tests/devices/device_test_util.h"
@@ -210,6 +214,63 @@ TEST(RecordingCorruption, SeededFuzzNeverCrashesAndNeverInventsFrames) {
     }
   }
   EXPECT_GT(delivered, 0);  // the loop really exercised replay, not only open failures
+}
+
+}  // namespace
+}  // namespace plumb
+
+namespace plumb {
+namespace {
+
+// A header that claims more bytes than the file has left but is otherwise valid (its own CRC
+// holds): damage when a valid chunk follows (the later frames are kept), not a power-cut tail.
+TEST(RecordingCorruption, AnOversizedChunkHeaderCostsOnlyItsChunk) {
+  test::ScratchDir dir("oversize");
+  const WrittenRecording rec = writeRecording(dir.file("full.plumbrec"), 5, ImageCodec::kRaw, 24, 16);
+  std::vector<uint8_t> bytes = rec.bytes;
+  const uint64_t start = rec.frame_starts[1];
+  // payload size <- the largest value the format allows, header CRC recomputed.
+  std::vector<uint8_t> patched(bytes.begin(), bytes.end());
+  ByteWriter w(patched);
+  w.patchU32(start + 8, static_cast<uint32_t>(kMaxChunkPayload));
+  w.patchU32(start + 12, crc32(patched.data() + start, 12));
+  writeBytes(dir.file("oversize.plumbrec"), patched.data(), patched.size());
+  const ReplayResult r = replay(dir.file("oversize.plumbrec"));
+  ASSERT_TRUE(r.opened);
+  EXPECT_EQ(r.frames.size(), rec.frames.size() - 1);
+  EXPECT_EQ(r.stats.chunks_skipped, 1u);
+  EXPECT_EQ(r.stats.truncated_tail_bytes, 0u) << "reported as a cut tail: " << r.stats.last_damage;
+  EXPECT_TRUE(r.stats.end_chunk_seen);
+}
+
+// Frames whose timestamps are NaN, repeated or going backwards (CRC intact) are damage: skipped,
+// counted and named, never delivered into a trajectory.
+TEST(RecordingCorruption, NanRepeatedAndBackwardTimestampsAreSkippedAsDamage) {
+  test::ScratchDir dir("time");
+  std::vector<RgbdImage> frames = test::makeNoiseFrames(5, 24, 16, 6);
+  const double stamps[] = {1.0, std::nan(""), 1.1, 1.1, 1.05, 1.2};
+  for (std::size_t i = 0; i < frames.size(); ++i) frames[i].timestamp_s = frames[i].depth_timestamp_s = stamps[i];
+  RecordingWriterOptions options;
+  options.colour_codec = options.depth_codec = ImageCodec::kRaw;
+  options.fsync = FsyncPolicy::kNever;
+  std::unique_ptr<RecordingWriter> writer;
+  ASSERT_TRUE(RecordingWriter::open(dir.file("t.plumbrec"), test::smallCamera(24, 16), options, &writer).ok());
+  for (const RgbdImage& f : frames) ASSERT_TRUE(writer->append(f).ok());
+  ASSERT_TRUE(writer->close().ok());
+  const ReplayResult r = replay(dir.file("t.plumbrec"));
+  ASSERT_TRUE(r.opened);
+  ASSERT_EQ(r.frames.size(), 3u);
+  EXPECT_EQ(r.frames[0].timestamp_s, 1.0);
+  EXPECT_EQ(r.frames[1].timestamp_s, 1.1);
+  EXPECT_EQ(r.frames[2].timestamp_s, 1.2);
+  EXPECT_EQ(r.stats.chunks_skipped, 3u);
+  std::unique_ptr<RecordingSource> source;
+  ASSERT_TRUE(RecordingSource::open(dir.file("t.plumbrec"), &source).ok());
+  RgbdImage out;
+  while (source->next(out) == SourceResult::kFrame) {
+  }
+  EXPECT_TRUE(source->damage().any());
+  EXPECT_EQ(source->damage().regions_skipped, 3u);
 }
 
 }  // namespace

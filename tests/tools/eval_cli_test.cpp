@@ -57,6 +57,21 @@ TEST(EvalCli, Freiburg2DeskJsonAndPlot) {
   EXPECT_GT(cv::countNonZero(not_white), image.total() / 100);
 }
 
+// Values near the double range overflow the statistics: the JSON must stay JSON (null, never inf).
+TEST(EvalCli, JsonIsValidWhenTheNumbersOverflow) {
+  ScratchDir dir;
+  const std::string gt = dir.write("gt.txt", "1.0 1e308 0 0 0 0 0 1\n2.0 -1e308 0 0 0 0 0 1\n3.0 1e308 1e308 0 0 0 0 1\n");
+  const std::string est = dir.write("est.txt", "1.0 0 0 0 0 0 0 1\n2.0 1 0 0 0 0 0 1\n3.0 2 1 0 0 0 0 1\n");
+  const RunResult r = runPlumb("eval --gt " + gt + " --est " + est + " --json");
+  if (r.exit_code == 0) {
+    EXPECT_EQ(r.output.find("inf"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("nan"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("\"rmse_m\": "), std::string::npos) << r.output;
+  } else {
+    EXPECT_FALSE(r.output.empty());  // refused with a message: also acceptable
+  }
+}
+
 TEST(EvalCli, MissingFileExitsNonZeroNamingIt) {
   ScratchDir dir;
   const std::string gt = dir.write("gt.txt", "1.0 0 0 0 0 0 0 1\n");

@@ -188,3 +188,37 @@ TEST(RunStop, SigintKeepsEveryComputedPoseAndSaysSo) {
 
 }  // namespace
 }  // namespace plumb::test
+
+namespace plumb::test {
+namespace {
+
+TEST(OtherCommandsDataSafety, RecordRefusesToWriteOverItsSource) {
+  ScratchDir dir("plumb_record_safety");
+  ASSERT_TRUE(dir.ok());
+  const std::string rec = dir.file("x.plumbrec");
+  ASSERT_EQ(runPlumb("record --source synth:textured:1:5 --out '" + rec + "'").exit_code, 0);
+  const std::string before = readAll(rec);
+  ASSERT_GT(before.size(), 1000u);
+  const RunResult r = runPlumb("record --source '" + rec + "' --out '" + rec + "'");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_EQ(readAll(rec), before);
+}
+
+TEST(OtherCommandsDataSafety, SynthAndConvertRefuseToWriteOverADataset) {
+  ScratchDir dir("plumb_synth_safety");
+  ASSERT_TRUE(dir.ok());
+  const std::string ds = dir.file("ds");
+  ASSERT_EQ(runPlumb("synth --preset textured --frames 4 --out '" + ds + "'").exit_code, 0);
+  const std::string gt_before = readAll(ds + "/groundtruth.txt");
+  const RunResult again = runPlumb("synth --preset low_texture --frames 4 --out '" + ds + "'");
+  EXPECT_EQ(again.exit_code, 2) << again.output;
+  EXPECT_EQ(readAll(ds + "/groundtruth.txt"), gt_before);
+  const std::string rec = dir.file("ds.plumbrec");
+  ASSERT_EQ(runPlumb("convert '" + ds + "' '" + rec + "'").exit_code, 0);
+  const RunResult back = runPlumb("convert '" + rec + "' '" + ds + "'");
+  EXPECT_EQ(back.exit_code, 2) << back.output;
+  EXPECT_EQ(readAll(ds + "/groundtruth.txt"), gt_before);
+}
+
+}  // namespace
+}  // namespace plumb::test
