@@ -16,9 +16,9 @@
 
 namespace plumb {
 
-// Image sides plumb accepts (pixels): from a thumbnail to 8K. Everything that allocates per image
-// (slots, pyramids, decoders) is sized from a camera inside these bounds.
-constexpr int kMinImageSide = 16;
+// Largest image side plumb accepts (pixels): 8K. Everything that allocates per image (slots,
+// pyramids, decoders) is sized from a camera inside this bound. (Tracking has its own minimum:
+// OdometrySystem::create.)
 constexpr int kMaxImageSide = 8192;
 
 struct PinholeCamera {
@@ -85,9 +85,9 @@ struct PinholeCamera {
     if (width <= 0 || height <= 0) return "image size must be positive";
     // Bounds checked before anything is allocated for an image (a 100000-pixel-wide "camera" is a
     // typo or a hostile file, not a sensor): docs/DATA_FORMATS.md.
-    if (width < kMinImageSide || height < kMinImageSide || width > kMaxImageSide || height > kMaxImageSide)
-      return "image size " + std::to_string(width) + "x" + std::to_string(height) + " is outside " +
-             std::to_string(kMinImageSide) + ".." + std::to_string(kMaxImageSide) + " pixels per side";
+    if (width > kMaxImageSide || height > kMaxImageSide)
+      return "image size " + std::to_string(width) + "x" + std::to_string(height) + " exceeds " +
+             std::to_string(kMaxImageSide) + " pixels per side";
     if (!finite(depth_factor) || depth_factor <= 0) return "depth factor must be positive";
     if (!finite(baseline_m) || baseline_m <= 0) return "baseline must be positive";
     if (!finite(rolling_shutter_readout_s) || rolling_shutter_readout_s < 0)

@@ -41,6 +41,12 @@ Status OdometrySystem::create(const PinholeCamera& camera, const SystemOptions& 
   PLUMB_RETURN_IF_ERROR(validate(options));
   const std::string camera_problem = camera.validate();
   if (!camera_problem.empty()) return Status::Error("camera: " + camera_problem);
+  // The 8-level pyramid and line detection need room: smaller images are refused, not tracked badly.
+  constexpr int kMinTrackedSide = 64;
+  if (camera.width < kMinTrackedSide || camera.height < kMinTrackedSide) {
+    return Status::Error("camera: image size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+                         " is too small to track (at least " + std::to_string(kMinTrackedSide) + " pixels per side)");
+  }
   out->reset(new OdometrySystem(camera, options));
   return Status::Ok();
 }
