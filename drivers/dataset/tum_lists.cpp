@@ -36,6 +36,25 @@ bool startsWith(const std::string& text, const char* prefix) { return text.rfind
 
 }  // namespace
 
+namespace {
+
+// A list entry names a file INSIDE the dataset folder: relative, no ".." component. A list that
+// points elsewhere (`../../../etc/passwd`, `/home/x/y.png`) is refused, never followed.
+Status checkEntryPath(const std::string& where, const std::string& path) {
+  if (path.empty() || path[0] == '/') return Status::Error(where + ": '" + path + "' is not a path inside the dataset folder");
+  std::size_t start = 0;
+  while (start <= path.size()) {
+    const std::size_t slash = path.find('/', start);
+    const std::string part = path.substr(start, slash == std::string::npos ? std::string::npos : slash - start);
+    if (part == "..") return Status::Error(where + ": '" + path + "' leaves the dataset folder (..)");
+    if (slash == std::string::npos) break;
+    start = slash + 1;
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
 Status readTumImageList(const std::string& list_path, std::vector<TumListEntry>* out) {
   out->clear();
   std::vector<TextLine> lines;
@@ -49,6 +68,7 @@ Status readTumImageList(const std::string& list_path, std::vector<TumListEntry>*
     TumListEntry entry;
     PLUMB_RETURN_IF_ERROR(parseStamp(where, line.tokens[0], &entry.timestamp_s));
     entry.path = line.tokens[1];
+    PLUMB_RETURN_IF_ERROR(checkEntryPath(where, entry.path));
     entry.line = line.number;
     if (!out->empty())
       PLUMB_RETURN_IF_ERROR(
@@ -79,6 +99,8 @@ Status readTumAssociations(const std::string& list_path, std::vector<TumFrameEnt
     entry.rgb_path = line.tokens[rgb_column + 1];
     PLUMB_RETURN_IF_ERROR(parseStamp(where, line.tokens[depth_column], &entry.depth_timestamp_s));
     entry.depth_path = line.tokens[depth_column + 1];
+    PLUMB_RETURN_IF_ERROR(checkEntryPath(where, entry.rgb_path));
+    PLUMB_RETURN_IF_ERROR(checkEntryPath(where, entry.depth_path));
     if (!out->empty()) {
       PLUMB_RETURN_IF_ERROR(
           checkIncreasing(where, "rgb", out->back().rgb_timestamp_s, previous_line, entry.rgb_timestamp_s));

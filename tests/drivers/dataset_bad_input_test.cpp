@@ -91,6 +91,17 @@ TEST_F(BadDataset, TheValidFixtureLoads) {
   EXPECT_EQ(source->next(frame), SourceResult::kEndOfStream);
 }
 
+// A list may only name files inside the dataset folder: "..", absolute paths are refused at open
+// with the list's file and line, and nothing outside the folder is read.
+TEST_F(BadDataset, ListEntriesOutsideTheFolderAreRefused) {
+  for (const std::string bad : {"../../../etc/passwd", "/etc/passwd", "rgb/../../x.png"}) {
+    write("rgb.txt", "# color images\n1.000000 rgb/1.000000.png\n1.033333 " + bad + "\n");
+    std::unique_ptr<TumDatasetSource> source;
+    const Status st = open(&source);
+    expectMentions(st, "rgb.txt:3", bad);
+  }
+}
+
 TEST_F(BadDataset, MissingImageFileIsReportedAtOpen) {
   std::filesystem::remove(file("depth/1.038000.png"));
   std::unique_ptr<TumDatasetSource> source;
