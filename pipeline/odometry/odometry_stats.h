@@ -15,6 +15,9 @@ struct OdometryStats {
   uint64_t relocalizations = 0;
   uint64_t relocalization_attempts = 0;
   uint64_t segments = 0;                // maps started (1 = never restarted)
+  // Frames the output queue could not take because the caller did not drain it (never with the
+  // runner, which drains after every frame): counted, never silently overwritten.
+  uint64_t output_overflows = 0;
 };
 
 }  // namespace plumb

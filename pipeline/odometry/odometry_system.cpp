@@ -202,7 +202,7 @@ const FrameOutput& OdometrySystem::mapFrame(const TrackedFrame& tracked) {
     }
   }
   recordOutput(tracked);
-  mapping_.trajectory.push(mapping_.output.sequence, mapping_.output.timestamp_s, mapping_.output.has_pose, mapping_.output.T_world_cam, reference_id,
+  mapping_.stats.output_overflows += !mapping_.trajectory.push(mapping_.output.sequence, mapping_.output.timestamp_s, mapping_.output.has_pose, mapping_.output.T_world_cam, reference_id,
                    T_ref_cam);
   return mapping_.output;
 }
@@ -212,7 +212,7 @@ const FrameOutput& OdometrySystem::mapDroppedFrame(uint64_t sequence, double tim
   mapping_.output.sequence = sequence;
   mapping_.output.timestamp_s = timestamp_s;
   mapping_.output.dropped = true;
-  mapping_.trajectory.pushDropped(sequence, timestamp_s);
+  mapping_.stats.output_overflows += !mapping_.trajectory.pushDropped(sequence, timestamp_s);
   return mapping_.output;
 }
 

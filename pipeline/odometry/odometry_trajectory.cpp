@@ -7,8 +7,9 @@ namespace plumb {
 OdometryTrajectory::OdometryTrajectory(int delay_frames)
     : delay_(std::clamp(delay_frames, 0, kMaxDelayFrames - 1)) {}
 
-void OdometryTrajectory::push(uint64_t sequence, double timestamp_s, bool valid, const Eigen::Isometry3d& T_world_cam,
+bool OdometryTrajectory::push(uint64_t sequence, double timestamp_s, bool valid, const Eigen::Isometry3d& T_world_cam,
                               uint32_t reference_id, const Eigen::Isometry3d& T_ref_cam) {
+  if (full()) return false;
   Pending& p = fifo_[(head_ + size_) % kMaxDelayFrames];
   ++size_;
   p.frame.sequence = sequence;
@@ -18,6 +19,7 @@ void OdometryTrajectory::push(uint64_t sequence, double timestamp_s, bool valid,
   p.frame.T_world_cam = T_world_cam;
   p.reference_id = valid ? reference_id : 0;
   p.T_ref_cam = T_ref_cam;
+  return true;
 }
 
 FinishedFrame OdometryTrajectory::resolve(const LocalMap& map, const Pending& p) {

@@ -28,14 +28,19 @@ class OdometryTrajectory {
   static constexpr int kMaxDelayFrames = 256;
   explicit OdometryTrajectory(int delay_frames);
 
-  // Adds a frame. reference_id 0 = no reference (pose used as given).
-  void push(uint64_t sequence, double timestamp_s, bool valid, const Eigen::Isometry3d& T_world_cam,
+  // Adds a frame. reference_id 0 = no reference (pose used as given). false, and nothing is
+  // overwritten, when the queue is full: the caller must pop ready frames after every push (the
+  // runner does); full() tells beforehand.
+  bool push(uint64_t sequence, double timestamp_s, bool valid, const Eigen::Isometry3d& T_world_cam,
             uint32_t reference_id, const Eigen::Isometry3d& T_ref_cam);
   // A frame the runtime dropped before processing: it keeps its place in the output order.
-  void pushDropped(uint64_t sequence, double timestamp_s) {
-    push(sequence, timestamp_s, false, Eigen::Isometry3d::Identity(), 0, Eigen::Isometry3d::Identity());
+  bool pushDropped(uint64_t sequence, double timestamp_s) {
+    if (!push(sequence, timestamp_s, false, Eigen::Isometry3d::Identity(), 0, Eigen::Isometry3d::Identity()))
+      return false;
     fifo_[(head_ + size_ - 1) % kMaxDelayFrames].frame.dropped = true;
+    return true;
   }
+  bool full() const { return size_ >= kMaxDelayFrames; }
   // Frames leaving the FIFO, resolved against the keyframe poses of `map`; calls fn(FinishedFrame)
   // for each. flushAll empties the FIFO (end of run).
   template <typename Fn>

@@ -185,5 +185,24 @@ TEST(OdometryTrajectory, DelayIsBoundedByTheRing) {
   EXPECT_EQ(now.frames.size(), 1u);
 }
 
+// A caller that does not drain: a full queue refuses the next frame (counted by the system)
+// instead of overwriting the oldest, so no frame is silently lost or emitted twice.
+TEST(OdometryTrajectory, AFullQueueRefusesInsteadOfOverwriting) {
+  const LocalMap empty;
+  const int kMax = OdometryTrajectory::kMaxDelayFrames;
+  OdometryTrajectory trajectory(300);
+  int accepted = 0;
+  for (int i = 0; i < kMax + 4; ++i) {
+    accepted += trajectory.push(uint64_t(i), 0.0, true, frameOffset(i % 50), 0, Eigen::Isometry3d::Identity());
+  }
+  EXPECT_EQ(accepted, kMax);
+  EXPECT_TRUE(trajectory.full());
+  EXPECT_FALSE(trajectory.pushDropped(999, 1.0));
+  Collector out;
+  trajectory.flushAll(empty, out.fn());
+  ASSERT_EQ(out.frames.size(), std::size_t(kMax));
+  for (int i = 0; i < kMax; ++i) EXPECT_EQ(out.frames[std::size_t(i)].sequence, uint64_t(i));
+}
+
 }  // namespace
 }  // namespace plumb
