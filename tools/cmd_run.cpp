@@ -222,10 +222,10 @@ int runRun(int argc, char** argv) {
               statistics.extractNs().meanNs() * 1e-6, statistics.trackNs().meanNs() * 1e-6,
               statistics.mapNs().meanNs() * 1e-6);
   const runtime::RunReport& report = record.run.report;
-  std::printf("%s: %.1f frames/s, dropped %llu, late %llu, extraction failures %llu\n",
+  std::printf("%s: %.1f frames/s, dropped %llu, late %llu, extraction failures %llu, waits for the mapper %llu\n",
               runtime::runModeName(run_options.schedule.mode), report.framesPerSecond(),
               (unsigned long long)report.frames_dropped, (unsigned long long)report.frames_late,
-              (unsigned long long)record.run.extraction_failures);
+              (unsigned long long)record.run.extraction_failures, (unsigned long long)record.mapper_waits);
   if (args.has("count-allocations")) {
     if (record.run.allocation_frames == 0) {
       std::printf("allocations: run not longer than the %llu-frame warm-up\n",

@@ -97,6 +97,7 @@ Status runToOutputs(FrameSource& source, const SystemOptions& system_options, co
   if (status.ok()) status = closed;
   record->odometry = system->stats();
   record->mapper = system->mapperStats();
+  record->mapper_waits = system->mapperWaits();
   return status;
 }
 

@@ -58,6 +58,7 @@ struct RunRecord {
   OdometryRunResult run;
   OdometryStats odometry;
   MapperStats mapper;
+  uint64_t mapper_waits = 0;  // threaded runs: times tracking waited for a lagging map stage
 };
 
 // Builds the system (options validated there), runs it over `source` through the one runner into

@@ -71,6 +71,9 @@ struct SystemOptions {
   OdometryOptions odometry;
   // Output delay of the reference-keyframe-relative trajectory (frames); 0 = poses as tracked.
   int output_delay_frames = 60;
+  // Threaded runs: frames the tracker may run past a pending keyframe request before it waits for
+  // the map stage to publish that keyframe (bounded staleness under CPU load; docs/RUNTIME.md).
+  int max_frames_ahead_of_mapper = 4;
 };
 
 // Every option of the system in one place; validated once, where the system is built.
@@ -114,6 +117,8 @@ class OdometrySystem {
     drainRetiredKeyframes(keyframe_fn);
   }
   const OdometryStats& stats() const { return mapping_.stats; }
+  // Tracking side: how often tracking waited for a lagging mapper (max_frames_ahead_of_mapper).
+  uint64_t mapperWaits() const { return tracking_.mapper_waits; }
   const MapperStats& mapperStats() const { return mapping_.mapper->stats(); }
   MapCounts mapCounts() const { return mapping_.mapper->map().counts(); }
 
@@ -128,6 +133,8 @@ class OdometrySystem {
     int lost_streak = 0;
     Eigen::Isometry3d T_world_last_good = Eigen::Isometry3d::Identity();
     uint64_t keyframe_requests = 0;  // handed to mapFrame()
+    int frames_since_request = 0;    // frames tracked while the newest request was pending
+    uint64_t mapper_waits = 0;       // times the bound above made tracking wait
   };
   // The mapping thread's state.
   struct MappingSide {
