@@ -46,6 +46,7 @@ void printRunUsage() {
       "  --rss-every N        record peak RSS every N frames in the statistics (poses are then not\n"
       "                       kept in memory: no synthetic ATE unless --gt is given)\n"
       "  --progress           a progress line every 100 frames on stderr\n"
+      "  --report-every N     every N frames: sensor-to-pose p50/p99/max, drops and RSS of the block\n"
       "  --trace              one line per frame on stderr: matches, inliers, keyframe, pose\n"
       "  --count-allocations  print heap allocations per frame after a 30-frame warm-up\n"
       "  --mavlink ENDPOINT   MAVLink v2 ODOMETRY + HEARTBEAT to an autopilot, as each pose is tracked:\n"
@@ -82,7 +83,7 @@ void onStopSignal(int signal) {
 int runRun(int argc, char** argv) {
   Args args(argc, argv,
             withScheduleFlags({"dataset", "camera", "out", "line-samples", "covariance", "stats", "max-frames",
-                               "gt", "output-delay", "rss-every", "mavlink"},
+                               "gt", "output-delay", "rss-every", "mavlink", "report-every"},
                               scheduleValueFlags()),
             withScheduleFlags({"no-lines", "synth-noise", "progress", "trace", "count-allocations", "discard-trajectory"},
                               scheduleSwitchFlags()));
@@ -103,7 +104,9 @@ int runRun(int argc, char** argv) {
   const long max_frames = args.getInt("max-frames", -1, &ok);
   const long output_delay = args.getInt("output-delay", 60, &ok);
   const long rss_every = args.getInt("rss-every", 0, &ok);
-  if (!ok) return fail("--line-samples, --max-frames, --output-delay and --rss-every take integers", kExitUsage);
+  const long report_every = args.getInt("report-every", 0, &ok);
+  if (!ok) return fail("--line-samples, --max-frames, --output-delay, --rss-every and --report-every take integers", kExitUsage);
+  if (rss_every < 0 || report_every < 0) return fail("--rss-every and --report-every take counts >= 0", kExitUsage);
   if (!args.has("out") && !args.has("discard-trajectory")) {
     return fail("--out FILE is required (or --discard-trajectory to run without keeping the poses)", kExitUsage);
   }
@@ -157,6 +160,7 @@ int runRun(int argc, char** argv) {
   output_options.trajectory_path = args.get("out");
   output_options.covariance_path = args.get("covariance");
   output_options.rss_every = rss_every;
+  output_options.report_every = report_every;
   output_options.progress = args.has("progress");
   output_options.trace = args.has("trace");
   // Only the ATE needs the poses in memory. A memory-profiling run (--rss-every) keeps nothing

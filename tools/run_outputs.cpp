@@ -4,6 +4,9 @@
 #include <cstdio>
 #include <memory>
 
+#include "platform/monotonic_time.h"
+#include "platform/process_memory.h"
+
 #include "drivers/common/source_capture.h"
 
 namespace plumb::tools {
@@ -24,6 +27,7 @@ Status RunOutputs::open() {
 }
 
 void RunOutputs::onPose(const FrameOutput& out) {
+  if (options_.report_every > 0) reportBlock(out);
   if (!mavlink_) return;
   OdometrySample sample;
   sample.timestamp_s = out.timestamp_s;
@@ -44,9 +48,29 @@ Status RunOutputs::close() {
   return Status::Ok();
 }
 
+void RunOutputs::reportBlock(const FrameOutput& out) {
+  block_latency_.add(monotonicNowNs() - out.t_sensor_ns);
+  if (++block_frames_ < uint64_t(options_.report_every)) return;
+  long peak_kib = 0, current_kib = 0;
+  readRss(&peak_kib, &current_kib);
+  const uint64_t dropped = dropped_total_.load(std::memory_order_relaxed);
+  std::printf("block %" PRIu64 ": frames %" PRIu64 ", sensor-to-pose p50 %.2f p99 %.2f max %.2f ms, dropped %" PRIu64
+              ", rss %ld KiB (peak %ld KiB)\n",
+              ++blocks_, block_frames_, double(block_latency_.percentileNs(0.5)) * 1e-6,
+              double(block_latency_.percentileNs(0.99)) * 1e-6, double(block_latency_.maxNs()) * 1e-6,
+              dropped - dropped_at_block_start_, current_kib, peak_kib);
+  std::fflush(stdout);
+  dropped_at_block_start_ = dropped;
+  block_latency_.clear();
+  block_frames_ = 0;
+}
+
 Status RunOutputs::onFrame(const FrameOutput& out) {
   statistics_.add(out);
-  if (out.dropped) return Status::Ok();
+  if (out.dropped) {
+    dropped_total_.fetch_add(1, std::memory_order_relaxed);
+    return Status::Ok();
+  }
   keyframes_ += out.keyframe;
   lost_ += !out.has_pose;
   const uint64_t frame = statistics_.frames();

@@ -3,6 +3,7 @@
 // produces: the TUM trajectory file, the keyframe covariance file, the poses kept in memory for the
 // ATE, statistics, and the --trace / --progress lines. Glue only: the formats live in
 // drivers/trajectory/, the statistics in pipeline/run/run_statistics.h.
+#include <atomic>
 #include <memory>
 #include <string>
 #include <vector>
@@ -24,6 +25,9 @@ struct RunOutputOptions {
   long rss_every = 0;           // > 0: an RSS checkpoint every this many frames
   bool progress = false;        // a line per 100 frames on stderr
   bool trace = false;           // a line per frame on stderr (matches, inliers, keyframes, pose)
+  // > 0: every this many frames a line on stdout with the block's sensor-to-pose p99, drops and
+  // resident memory (soak tests: scripts/soak.sh).
+  long report_every = 0;
   // MAVLink ODOMETRY to an autopilot (docs/MAVLINK.md): endpoint '' = off.
   MavlinkOptions mavlink;
 };
@@ -44,12 +48,19 @@ class RunOutputs final : public OdometrySink {
   const MavlinkOdometrySink* mavlink() const { return mavlink_.get(); }  // nullptr when off
 
  private:
+  void reportBlock(const FrameOutput& frame);
+
   RunOutputOptions options_;
   TumTrajectoryWriter trajectory_writer_;
   CovarianceWriter covariance_writer_;
   std::vector<StampedPose> trajectory_;
   RunStatistics statistics_;
   std::unique_ptr<MavlinkOdometrySink> mavlink_;
+  // --report-every, on the track stage's thread (onPose); drops arrive on the map stage's.
+  runtime::LatencyHistogram block_latency_;
+  uint64_t block_frames_ = 0, blocks_ = 0;
+  std::atomic<uint64_t> dropped_total_{0};
+  uint64_t dropped_at_block_start_ = 0;
   uint64_t keyframes_ = 0, lost_ = 0;
 };
 

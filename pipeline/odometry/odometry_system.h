@@ -54,6 +54,7 @@ struct FrameOutput {
   TrackResult track;
   InsertResult insert;
   double extract_ms = 0, track_ms = 0, map_ms = 0;
+  int64_t t_sensor_ns = 0;  // host monotonic time the frame was captured (set by the runner)
 };
 
 // What tracking hands to mapping for one frame. Large (the request holds a copy of the features),

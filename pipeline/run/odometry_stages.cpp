@@ -64,6 +64,7 @@ Status ExtractStage::process(OdometrySlot& slot, const runtime::FrameStamps&) {
 Status TrackStage::process(OdometrySlot& slot, const runtime::FrameStamps&) {
   system_.trackFeatures(*slot.features, slot.image.sequence, slot.image.timestamp_s, &fence_, slot.tracked.get());
   slot.tracked->output.extract_ms = slot.extract_ms;
+  slot.tracked->output.t_sensor_ns = slot.image.t_sensor_ns;
   fence_.frameTracked();
   sink_.onPose(slot.tracked->output);
   return Status::Ok();
