@@ -8,7 +8,6 @@
 namespace plumb {
 namespace {
 // Bound on stored image sizes: larger values can only come from a damaged or foreign file.
-constexpr int32_t kMaxImageSide = 16384;
 }  // namespace
 
 void encodeFileHeader(const PinholeCamera& camera, std::vector<uint8_t>& out) {
