@@ -6,9 +6,8 @@
 #include "drivers/recording/crc32.h"
 
 namespace plumb {
-namespace {
-// Bound on stored image sizes: larger values can only come from a damaged or foreign file.
-}  // namespace
+// Stored image sizes are bounded by the camera contract's kMaxImageSide (sensor/camera.h): larger
+// values can only come from a damaged or foreign file.
 
 void encodeFileHeader(const PinholeCamera& camera, std::vector<uint8_t>& out) {
   const std::size_t start = out.size();
