@@ -63,7 +63,8 @@ struct SynthOptions {
 
 // The frame count a preset is meant to be run with: 300 (10 s) for the room presets, 1200 (both
 // laps) for "loop", 900 (30 s, ~13.5 m of corridor) for "repeated"; 0 for an unknown preset.
-// SynthOptions::frames stays 300 unless set: a spec parser that was given no count can use this.
+// SynthOptions::frames stays 300 unless set; parseSynthSpec (synth_spec.h) uses this when a spec
+// gives no count, so `synth:loop` renders both laps.
 int presetDefaultFrames(const std::string& preset);
 
 // Empty-OK or a message naming the bad option (unknown preset, frames <= 0, fps <= 0, ...).

@@ -6,9 +6,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "drivers/synth/corridor_layout.h"
 #include "drivers/synth/frame_renderer.h"
+#include "drivers/synth/synth_spec.h"
 #include "drivers/synth/synthetic_scene.h"
 
 namespace plumb {
@@ -117,6 +121,16 @@ TEST(SynthLoopPreset, ViewIsNeverBlockedAndHasTexture) {
       }
     EXPECT_GT(valid, 0.95 * total) << "frame " << i;
     EXPECT_LT(near, 0.02 * valid) << "frame " << i;
+  }
+}
+
+TEST(SynthLoopPreset, SpecWithoutACountRendersThePresetsLength) {
+  for (const auto& [spec, frames] : std::vector<std::pair<std::string, int>>{
+           {"synth:loop", 1200}, {"synth:loop:4", 1200}, {"synth:loop:4:300", 300},
+           {"synth:repeated", 900}, {"synth:textured:2", 300}, {"synth:low_texture:2:77", 77}}) {
+    SynthOptions options;
+    ASSERT_TRUE(parseSynthSpec(spec, &options).ok()) << spec;
+    EXPECT_EQ(options.frames, frames) << spec;
   }
 }
 

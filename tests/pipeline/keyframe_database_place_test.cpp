@@ -7,7 +7,7 @@
 #include <memory>
 
 #include "drivers/synth/synthetic_scene.h"
-#include "pipeline/feature_extractor.h"
+#include "pipeline/frontend/feature_extractor.h"
 #include "pipeline/loop/keyframe_database.h"
 
 namespace plumb::loop {
