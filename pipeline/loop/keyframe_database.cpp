@@ -16,8 +16,8 @@ Status validate(const KeyframeDatabaseOptions& o) {
     return Status::Error("keyframe database: descriptor limits must be >= 0 and not both 0");
   if (o.max_postings < 1) return Status::Error("keyframe database: max_postings must be >= 1");
   if (o.bits_per_word < kMinWordBits || o.bits_per_word > kMaxWordBits)
-    return Status::Error("keyframe database: bits_per_word must be in " + std::to_string(kMinWordBits) + ".." +
-                         std::to_string(kMaxWordBits));
+    return Status::Error("keyframe database: bits_per_word must be in " + std::to_string(kMinWordBits) +
+                         ".." + std::to_string(kMaxWordBits));
   if (!(o.line_weight >= 0) || !(o.line_weight <= 1e6))
     return Status::Error("keyframe database: line_weight must be a number >= 0");
   return Status::Ok();
@@ -37,7 +37,8 @@ KeyframeDatabase::KeyframeDatabase(const KeyframeDatabaseOptions& options) : opt
   slots_.resize(std::size_t(options.max_keyframes));
   free_slots_.reserve(slots_.size());
   for (std::size_t i = slots_.size(); i-- > 0;) free_slots_.push_back(uint32_t(i));  // slot 0 on top
-  const std::size_t max_descriptors = std::size_t(options.max_point_descriptors + options.max_line_descriptors);
+  const std::size_t max_descriptors =
+      std::size_t(options.max_point_descriptors + options.max_line_descriptors);
   word_values_scratch_.resize(max_descriptors);
   words_scratch_.resize(max_descriptors);
   for (std::vector<double>& a : accumulator_) a.assign(slots_.size(), 0.0);
@@ -69,13 +70,15 @@ Status KeyframeDatabase::insert(uint64_t keyframe_id, const PlaceDescriptors& de
 Status KeyframeDatabase::insertWords(uint64_t keyframe_id, const WordCount* words, std::size_t num_words) {
   uint64_t totals64[2] = {0, 0};
   for (std::size_t i = 0; i < num_words; ++i) {
-    if (words[i].word >= num_words_total_ || words[i].count == 0 || (i > 0 && words[i].word <= words[i - 1].word))
+    if (words[i].word >= num_words_total_ || words[i].count == 0 ||
+        (i > 0 && words[i].word <= words[i - 1].word))
       return Status::Error("keyframe database: keyframe " + std::to_string(keyframe_id) +
                            ": word list not strictly ascending, out of range or with a zero count at entry " +
                            std::to_string(i));
     totals64[std::size_t(wordKind(words[i].word, options_.bits_per_word))] += words[i].count;
   }
-  if (totals64[0] > uint64_t(options_.max_point_descriptors) || totals64[1] > uint64_t(options_.max_line_descriptors))
+  if (totals64[0] > uint64_t(options_.max_point_descriptors) ||
+      totals64[1] > uint64_t(options_.max_line_descriptors))
     return Status::Error("keyframe database: keyframe " + std::to_string(keyframe_id) +
                          ": word counts exceed the descriptor limits");
   const uint32_t totals[2] = {uint32_t(totals64[0]), uint32_t(totals64[1])};
@@ -90,9 +93,9 @@ Status KeyframeDatabase::insertHistogram(uint64_t keyframe_id, const WordCount* 
   if (free_slots_.empty())
     return Status::Error("keyframe database: full (" + std::to_string(slots_.size()) + " keyframes)");
   if (num_words > free_postings_)
-    return Status::Error("keyframe database: out of postings (keyframe " + std::to_string(keyframe_id) + " needs " +
-                         std::to_string(num_words) + ", " + std::to_string(free_postings_) + " free of " +
-                         std::to_string(postings_.size()) + ")");
+    return Status::Error("keyframe database: out of postings (keyframe " + std::to_string(keyframe_id) +
+                         " needs " + std::to_string(num_words) + ", " + std::to_string(free_postings_) +
+                         " free of " + std::to_string(postings_.size()) + ")");
   const uint32_t slot_index = free_slots_.back();
   free_slots_.pop_back();
   KeyframeSlot& slot = slots_[slot_index];
@@ -182,17 +185,18 @@ std::size_t KeyframeDatabase::memoryBytesFor(const KeyframeDatabaseOptions& o) {
   const std::size_t words = std::size_t(2) << o.bits_per_word;
   const std::size_t keyframes = std::size_t(o.max_keyframes);
   const std::size_t descriptors = std::size_t(o.max_point_descriptors + o.max_line_descriptors);
-  return sizeof(KeyframeDatabase) + words * 2 * sizeof(uint32_t) + std::size_t(o.max_postings) * sizeof(Posting) +
+  return sizeof(KeyframeDatabase) + words * 2 * sizeof(uint32_t) +
+         std::size_t(o.max_postings) * sizeof(Posting) +
          keyframes * (sizeof(KeyframeSlot) + sizeof(uint32_t) /*free_slots_*/ + 2 * sizeof(double) +
                       sizeof(uint32_t) + sizeof(uint8_t) + sizeof(Scored)) +
          descriptors * (sizeof(uint32_t) + sizeof(WordCount));
 }
 
 std::size_t KeyframeDatabase::memoryBytes() const {
-  return sizeof(*this) + word_head_.capacity() * sizeof(uint32_t) + word_keyframes_.capacity() * sizeof(uint32_t) +
-         postings_.capacity() * sizeof(Posting) + slots_.capacity() * sizeof(KeyframeSlot) +
-         free_slots_.capacity() * sizeof(uint32_t) + word_values_scratch_.capacity() * sizeof(uint32_t) +
-         words_scratch_.capacity() * sizeof(WordCount) +
+  return sizeof(*this) + word_head_.capacity() * sizeof(uint32_t) +
+         word_keyframes_.capacity() * sizeof(uint32_t) + postings_.capacity() * sizeof(Posting) +
+         slots_.capacity() * sizeof(KeyframeSlot) + free_slots_.capacity() * sizeof(uint32_t) +
+         word_values_scratch_.capacity() * sizeof(uint32_t) + words_scratch_.capacity() * sizeof(WordCount) +
          (accumulator_[0].capacity() + accumulator_[1].capacity()) * sizeof(double) +
          touched_slots_.capacity() * sizeof(uint32_t) + slot_touched_.capacity() * sizeof(uint8_t) +
          scored_scratch_.capacity() * sizeof(Scored);

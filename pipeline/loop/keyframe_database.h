@@ -79,7 +79,7 @@ using PlaceCandidates = FixedVector<PlaceCandidate, kMaxPlaceCandidates>;
 // Which keyframes a query may return. Two ways to leave out the local window: an id bound (the
 // keyframes are numbered in time, so `query_id - min_age` is a minimum age) and/or a predicate.
 struct PlaceQueryOptions {
-  std::size_t max_results = 10;  // <= kMaxPlaceCandidates
+  std::size_t max_results = 10;            // <= kMaxPlaceCandidates
   uint64_t max_candidate_id = UINT64_MAX;  // keyframes with a larger id are skipped
   // Optional: keyframes for which exclude(id, exclude_context) is true are skipped. A plain
   // function pointer (not std::function) so that a query never allocates.
@@ -115,7 +115,8 @@ class KeyframeDatabase {
   std::size_t keyframeIds(uint64_t* ids, std::size_t max_ids) const;
   // Distinct words of a keyframe (0 if unknown): the size keyframeWords() needs.
   std::size_t numKeyframeWords(uint64_t keyframe_id) const;
-  Status keyframeWords(uint64_t keyframe_id, WordCount* words, std::size_t max_words, std::size_t* num_words) const;
+  Status keyframeWords(uint64_t keyframe_id, WordCount* words, std::size_t max_words,
+                       std::size_t* num_words) const;
 
   // Bytes held by the database (the object and every buffer it allocated at construction).
   std::size_t memoryBytes() const;
@@ -161,10 +162,10 @@ class KeyframeDatabase {
   std::vector<uint32_t> word_head_;       // per word: first posting, kNone if empty
   std::vector<uint32_t> word_keyframes_;  // per word: n_w, keyframes containing it
   std::vector<Posting> postings_;
-  uint32_t free_posting_head_ = kNone;    // free postings chained through next_in_keyframe
+  uint32_t free_posting_head_ = kNone;  // free postings chained through next_in_keyframe
   std::size_t free_postings_ = 0;
   std::vector<KeyframeSlot> slots_;
-  std::vector<uint32_t> free_slots_;      // stack of free slot indices
+  std::vector<uint32_t> free_slots_;  // stack of free slot indices
   std::size_t num_keyframes_ = 0;
 
   // Query and insert scratch, sized at construction.

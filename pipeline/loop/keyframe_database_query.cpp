@@ -10,9 +10,11 @@ std::size_t KeyframeDatabase::histogram(const PlaceDescriptors& descriptors) {
   const int bits = options_.bits_per_word;
   std::size_t n = 0;
   for (std::size_t i = 0; i < descriptors.num_points; ++i)
-    word_values_scratch_[n++] = wordId(DescriptorKind::kPoint, descriptorWordValue(descriptors.points[i], bits), bits);
+    word_values_scratch_[n++] =
+        wordId(DescriptorKind::kPoint, descriptorWordValue(descriptors.points[i], bits), bits);
   for (std::size_t i = 0; i < descriptors.num_lines; ++i)
-    word_values_scratch_[n++] = wordId(DescriptorKind::kLine, descriptorWordValue(descriptors.lines[i], bits), bits);
+    word_values_scratch_[n++] =
+        wordId(DescriptorKind::kLine, descriptorWordValue(descriptors.lines[i], bits), bits);
   std::sort(word_values_scratch_.begin(), word_values_scratch_.begin() + std::ptrdiff_t(n));
   std::size_t distinct = 0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -82,10 +84,10 @@ void KeyframeDatabase::query(const PlaceDescriptors& descriptors, const PlaceQue
     scored_scratch_[num_scored++] = Scored{score, point_score, line_score, id};
   }
   const std::size_t keep = std::min({num_scored, options.max_results, kMaxPlaceCandidates});
-  std::partial_sort(scored_scratch_.begin(), scored_scratch_.begin() + std::ptrdiff_t(keep),
-                    scored_scratch_.begin() + std::ptrdiff_t(num_scored), [](const Scored& a, const Scored& b) {
-                      return a.score != b.score ? a.score > b.score : a.id < b.id;
-                    });
+  std::partial_sort(
+      scored_scratch_.begin(), scored_scratch_.begin() + std::ptrdiff_t(keep),
+      scored_scratch_.begin() + std::ptrdiff_t(num_scored),
+      [](const Scored& a, const Scored& b) { return a.score != b.score ? a.score > b.score : a.id < b.id; });
   for (std::size_t i = 0; i < keep; ++i) {
     const Scored& c = scored_scratch_[i];
     (void)out->push_back(PlaceCandidate{c.id, c.score, c.point_score, c.line_score});

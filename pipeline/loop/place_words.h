@@ -55,7 +55,7 @@ inline DescriptorKind wordKind(uint32_t word_id, int bits_per_word) {
 
 // A word and how many descriptors of one keyframe fall in it (its term frequency).
 struct WordCount {
-  uint32_t word = 0;   // wordId(kind, value, bits)
+  uint32_t word = 0;  // wordId(kind, value, bits)
   uint32_t count = 0;
 };
 

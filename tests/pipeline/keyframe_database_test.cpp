@@ -1,6 +1,8 @@
 // KeyframeDatabase (pipeline/loop/): queries against an independent brute-force scorer, place
 // recognition under bit noise, removal, capacity errors, enumeration round trip, and the
 // allocation-free contract of insert / query / remove.
+#include "pipeline/loop/keyframe_database.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,7 +13,6 @@
 #include <set>
 #include <vector>
 
-#include "pipeline/loop/keyframe_database.h"
 #include "platform/allocation_counter.h"
 
 namespace plumb::loop {
@@ -230,7 +231,8 @@ TEST(KeyframeDatabase, ReobservedKeyframeRanksFirst) {
     EXPECT_GT(got[0].line_score, 0.1);
     EXPECT_GT(got[0].score, 5 * got[1].score) << "the true place stands out";
     std::printf("target %llu: score %.3f (points %.3f lines %.3f), runner-up %.4f\n",
-                (unsigned long long)target, got[0].score, got[0].point_score, got[0].line_score, got[1].score);
+                (unsigned long long)target, got[0].score, got[0].point_score, got[0].line_score,
+                got[1].score);
 
     // The local window excluded: the true keyframe is not returned.
     qo.max_candidate_id = target - 1;
@@ -346,7 +348,8 @@ TEST(KeyframeDatabase, EnumerateAndReinsertGivesTheSameDatabase) {
     ASSERT_TRUE(original.keyframeWords(id, words.data(), words.size(), &n).ok());
     ASSERT_EQ(n, words.size());
     // The words are the keyframe's histogram.
-    const auto it = std::find_if(keyframes.begin(), keyframes.end(), [id](const TestKeyframe& k) { return k.id == id; });
+    const auto it =
+        std::find_if(keyframes.begin(), keyframes.end(), [id](const TestKeyframe& k) { return k.id == id; });
     const std::map<uint32_t, int> h = oracle.histogram(*it);
     ASSERT_EQ(h.size(), n);
     std::size_t i = 0;
@@ -421,10 +424,10 @@ TEST(KeyframeDatabase, MemoryIsFixedAndReported) {
   EXPECT_EQ(allocated, db->memoryBytes());
   std::printf("default KeyframeDatabase: %zu bytes (%.2f MiB); posting %zu bytes\n", db->memoryBytes(),
               db->memoryBytes() / 1048576.0, (db->memoryBytes() - KeyframeDatabase::memoryBytesFor([] {
-                                                 KeyframeDatabaseOptions o;
-                                                 o.max_postings -= 1;
-                                                 return o;
-                                               }())));
+                                                KeyframeDatabaseOptions o;
+                                                o.max_postings -= 1;
+                                                return o;
+                                              }())));
 }
 
 }  // namespace
