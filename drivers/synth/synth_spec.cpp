@@ -37,6 +37,8 @@ Status parseSynthSpec(const std::string& spec, SynthOptions* options) {
   }
   if (parts.size() > 2 && (!parseInt(parts[2], &options->frames) || options->frames <= 0))
     return Status::Error(spec + ": frames '" + parts[2] + "' is not a positive integer");
+  // No count: the length the preset is meant for (300 for the room presets, both laps of "loop").
+  if (parts.size() <= 2 && presetDefaultFrames(options->preset) > 0) options->frames = presetDefaultFrames(options->preset);
   return validate(*options).withContext(spec);
 }
 

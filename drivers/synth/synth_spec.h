@@ -14,7 +14,8 @@ namespace plumb {
 // True when `spec` names a synthetic scene (starts with "synth:").
 bool isSynthSpec(const std::string& spec);
 
-// Fills options->preset/seed/frames from the spec (other fields untouched) and validates.
+// Fills options->preset/seed/frames from the spec (other fields untouched) and validates. Without
+// FRAMES, frames = presetDefaultFrames(PRESET) (300; "loop" 1200, "repeated" 900).
 Status parseSynthSpec(const std::string& spec, SynthOptions* options);
 
 // Kinect-like sensor noise: axial depth noise sigma = 0.0014 z^2, holes on the far side of depth
