@@ -73,18 +73,21 @@ Status IoPlan::check() const {
       return Status::Error(out.flag + " " + out.path + ": not a regular file (outputs replace their path when complete)");
     }
     if (exists) {
+      // The same file first (the clearest message), then a file inside an input folder.
+      for (const std::string& input : inputs_) {
+        FileId in_id;
+        if (fileId(input, &in_id) && in_id == out_id) {
+          return Status::Error(out.flag + " " + out.path + " is an input of this command (" + input +
+                               "): refusing to overwrite it");
+        }
+      }
       const std::string out_real = realPath(out.path);
       for (const std::string& input : inputs_) {
         FileId in_id;
         bool in_is_dir = false;
-        if (!fileId(input, &in_id, &in_is_dir)) continue;
-        if (in_id == out_id) {
-          return Status::Error(out.flag + " " + out.path + " is an input of this command (" + input +
-                               "): refusing to overwrite it");
-        }
-        if (in_is_dir && isInside(out_real, realPath(input))) {
+        if (fileId(input, &in_id, &in_is_dir) && in_is_dir && isInside(out_real, realPath(input))) {
           return Status::Error(out.flag + " " + out.path + " would overwrite a file of the input folder " + input +
-                               ": write it elsewhere");
+                               ": refusing to overwrite it; write it elsewhere");
         }
       }
     }

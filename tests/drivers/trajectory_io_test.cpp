@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include <cmath>
 
 #include "dataset_test_support.h"
@@ -145,8 +147,16 @@ TEST(TrajectoryIo, StreamingWriterMatchesBatchWriter) {
     TumTrajectoryWriter writer;
     ASSERT_TRUE(writer.open(dir.file("b.txt")).ok());
     for (const StampedPose& p : poses) ASSERT_TRUE(writer.append(p).ok());
-  }  // closed by the destructor
+    ASSERT_TRUE(writer.close().ok());
+  }
   EXPECT_EQ(testing::readWholeFile(dir.file("a.txt")), testing::readWholeFile(dir.file("b.txt")));
+  {
+    // A writer destroyed without close() (a crash, an error path) leaves no file that looks whole.
+    TumTrajectoryWriter writer;
+    ASSERT_TRUE(writer.open(dir.file("c.txt")).ok());
+    for (const StampedPose& p : poses) ASSERT_TRUE(writer.append(p).ok());
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("c.txt")));
   TumTrajectoryWriter bad;
   const Status st = bad.open(dir.file("no/such/dir/t.txt"));
   ASSERT_FALSE(st.ok());

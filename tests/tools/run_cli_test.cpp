@@ -126,7 +126,8 @@ TEST_F(RunDataSafety, OutputOverAFileOfTheInputFolderIsRefused) {
 
 TEST_F(RunDataSafety, BadOutputPathsAreRefusedBeforeAnyWork) {
   const std::string out = dir_.file("t.txt");
-  for (const std::string extra : {"--stats /nonexistent/folder/s.json", "--profile /nonexistent/p.json",
+  for (const std::string extra : {std::string("--stats /nonexistent/folder/s.json"),
+                                  std::string("--profile /nonexistent/p.json"),
                                   "--covariance '" + dir_.file("") + "'"}) {
     const RunResult r = runPlumb("run --dataset '" + dataset_ + "' --out '" + out + "' " + extra);
     EXPECT_EQ(r.exit_code, 2) << extra << ": " << r.output;
@@ -160,7 +161,7 @@ TEST(RunStop, SigintKeepsEveryComputedPoseAndSaysSo) {
   ASSERT_TRUE(dir.ok());
   const std::string out = dir.file("t.txt"), stats = dir.file("s.json");
   // Long enough never to finish within the timeout on any machine.
-  const std::string command = "timeout -s INT 4 '" + kPlumbBinary +
+  const std::string command = "timeout --preserve-status -s INT 4 '" + kPlumbBinary +
                               "' run --dataset synth:textured:1:100000 --out '" + out + "' --stats '" + stats +
                               "' 2>&1";
   std::FILE* pipe = ::popen(command.c_str(), "r");
