@@ -9,6 +9,7 @@ CameraValues toValues(const PinholeCamera& c) {
   v.width = c.width, v.height = c.height;
   v.depth_factor = c.depth_factor;
   v.baseline_m = c.baseline_m;
+  v.rolling_shutter_readout_s = c.rolling_shutter_readout_s;
   return v;
 }
 
@@ -19,6 +20,7 @@ PinholeCamera toCamera(const CameraValues& v) {
   c.width = v.width, c.height = v.height;
   c.depth_factor = v.depth_factor;
   c.baseline_m = v.baseline_m;
+  c.rolling_shutter_readout_s = v.rolling_shutter_readout_s;
   return c;
 }
 

@@ -55,6 +55,9 @@ struct CameraValues {
   int width = 640, height = 480;
   double depth_factor = 5000.0;  // raw depth units per metre (TUM 5000, millimetre images 1000)
   double baseline_m = 0.08;      // virtual stereo baseline of the point observation
+  // Rolling shutter: seconds from the first to the last row's exposure (0 = global shutter; the
+  // TUM presets: 0.025). The tracker moves features to the middle row's time.
+  double rolling_shutter_readout_s = 0.0;
 };
 
 // Where the camera comes from: a preset name (tum1 tum2 tum3 icl), a camera file (docs/DATA_FORMATS.md),

@@ -100,7 +100,9 @@ api::CameraValues cameraFromDict(const py::dict& d) {
     else if (key == "height") v.height = value.cast<int>();
     else if (key == "depth_factor") v.depth_factor = value.cast<double>();
     else if (key == "baseline") v.baseline_m = value.cast<double>();
-    else throw py::value_error("unknown camera key '" + key + "' (fx fy cx cy k1 k2 p1 p2 k3 width height depth_factor baseline)");
+    else if (key == "rolling_shutter_readout") v.rolling_shutter_readout_s = value.cast<double>();
+    else throw py::value_error("unknown camera key '" + key + "' (fx fy cx cy k1 k2 p1 p2 k3 width height "
+                               "depth_factor baseline rolling_shutter_readout)");
   }
   return v;
 }
@@ -110,6 +112,7 @@ py::dict cameraToDict(const api::CameraValues& v) {
   d["fx"] = v.fx, d["fy"] = v.fy, d["cx"] = v.cx, d["cy"] = v.cy;
   d["k1"] = v.k1, d["k2"] = v.k2, d["p1"] = v.p1, d["p2"] = v.p2, d["k3"] = v.k3;
   d["width"] = v.width, d["height"] = v.height, d["depth_factor"] = v.depth_factor, d["baseline"] = v.baseline_m;
+  d["rolling_shutter_readout"] = v.rolling_shutter_readout_s;
   return d;
 }
 
@@ -179,7 +182,8 @@ std::vector<api::FinishedPose> trajectoryFromObject(const py::handle& object, co
     throw py::value_error(std::string(name) + ": 'timestamps' must be (N,) and 'poses' (N,4,4)");
   }
   py::array_t<bool> valid;
-  if (d.contains("valid")) {
+  const bool has_valid = d.contains("valid");  // a default array_t is an empty array, not null
+  if (has_valid) {
     valid = py::array_t<bool, py::array::c_style | py::array::forcecast>::ensure(d["valid"]);
     if (!valid || valid.ndim() != 1 || valid.shape(0) != t.shape(0)) throw py::value_error(std::string(name) + ": 'valid' must be (N,)");
   }
@@ -189,7 +193,7 @@ std::vector<api::FinishedPose> trajectoryFromObject(const py::handle& object, co
   for (std::size_t i = 0; i < poses.size(); ++i) {
     poses[i].sequence = i;
     poses[i].timestamp_s = tm(py::ssize_t(i));
-    poses[i].valid = valid ? valid.at(py::ssize_t(i)) : true;
+    poses[i].valid = has_valid ? valid.at(py::ssize_t(i)) : true;
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 4; ++c) poses[i].T_world_cam.matrix()(r, c) = Tm(py::ssize_t(i), r, c);
   }

@@ -199,6 +199,7 @@ TEST(OdometryApi, CameraFromPresetFileOrValues) {
   ASSERT_TRUE(resolveCamera(CameraSpec::named("tum1"), &tum1).ok);
   EXPECT_DOUBLE_EQ(tum1.fx, 517.306408);
   EXPECT_EQ(tum1.width, 640);
+  EXPECT_EQ(tum1.rolling_shutter_readout_s, 0.025);  // every field of the camera crosses the API
   CameraValues unused;
   Status st = resolveCamera(CameraSpec::named("tum9"), &unused);
   EXPECT_FALSE(st.ok);
