@@ -169,3 +169,21 @@ def test_head250_from_numpy_is_byte_identical_to_plumb_run(plumb_binary, dataset
             assert (T is None) == (T2 is None)
             if T is not None:
                 assert np.array_equal(T, T2)
+
+
+def test_read_tum_frame_is_the_readers_frame(datasets_dir):
+    folder = os.path.join(datasets_dir, "tum_fr1_rpy_head250")
+    if not os.path.exists(os.path.join(folder, "rgb.txt")):
+        pytest.skip("tum_fr1_rpy_head250 not present")
+    reader = plumb.FrameReader(folder)
+    frames = [reader.next() for _ in range(3)]
+    rgb, depth, t = plumb.read_tum_frame(folder, 2)
+    assert t == frames[2][2]
+    assert np.array_equal(rgb, frames[2][0]) and np.array_equal(depth, frames[2][1])
+    assert not np.array_equal(rgb, frames[1][0])
+    bgr, _, _ = reader.next(format="bgr")
+    rgb3, _, _ = plumb.read_tum_frame(folder, 3)
+    assert np.array_equal(bgr[:, :, ::-1], rgb3)
+    assert depth.max() > 0 and rgb.mean() > 10
+    with pytest.raises(IndexError):
+        plumb.read_tum_frame(folder, 250)
