@@ -29,7 +29,10 @@ import sys
 
 PRODUCT = ["platform", "runtime", "solver", "sensor", "pipeline/frontend", "pipeline/odometry",
            "pipeline/loop", "pipeline/run", "drivers"]
-FIXED_LAYERS = PRODUCT + ["tools", "tests/support", "bench", "fuzz"]
+# api/: the public front door (<plumb/odometry.h>, the Python module) over everything below it;
+# no product folder uses it. examples/: separate projects built against an INSTALLED plumb
+# (find_package(plumb)), so they include only <plumb/...> and link only plumb::plumb.
+FIXED_LAYERS = PRODUCT + ["api", "examples", "tools", "tests/support", "bench", "fuzz"]
 
 _PIPE = ["sensor", "solver", "runtime", "platform"]
 # Project folders a layer may include/link besides itself.
@@ -44,9 +47,11 @@ ALLOWED_LAYERS = {
     "pipeline/run": ["pipeline/loop", "pipeline/odometry", "pipeline/frontend"] + _PIPE,
     # solver/ for SE(3) maths only (output frame conventions, e.g. MAVLink's covariance).
     "drivers": ["sensor", "solver", "runtime", "platform"],
+    "api": PRODUCT,
+    "examples": [],
     "tools": PRODUCT,
     "tests/support": PRODUCT,
-    "tests/*": PRODUCT + ["tests/support"],
+    "tests/*": PRODUCT + ["api", "tests/support"],
     # Benchmarks and fuzzers may share test scaffolding, but only what tests/support holds.
     "bench": PRODUCT + ["tests/support"],
     "fuzz": PRODUCT + ["tests/support"],
@@ -109,6 +114,10 @@ def header_family(name):
         return "gtest"
     if name.startswith("ceres/"):
         return "ceres"
+    if name.startswith("pybind11/"):
+        return "pybind11"
+    if name.startswith("plumb/"):
+        return "plumb_installed"  # the installed public headers (examples/)
     return None
 
 
@@ -124,6 +133,8 @@ ALLOWED_FAMILIES = {
     "pipeline/loop": ["std", "eigen", "opencv_core", "opencv"],
     "pipeline/run": ["std", "eigen", "opencv_core", "opencv"],
     "drivers": _ALL_THIRD_PARTY,
+    "api": _ALL_THIRD_PARTY + ["pybind11"],
+    "examples": ["std", "eigen", "plumb_installed"],
     "tools": _ALL_THIRD_PARTY,
     "tests/support": _ALL_THIRD_PARTY + ["gtest"],
     "tests/*": _ALL_THIRD_PARTY + ["gtest", "ceres"],  # Ceres: a test-only oracle
@@ -144,6 +155,8 @@ LINK_FAMILIES = [
     (r"PkgConfig::LIBUSB|usb-1\.0", "libusb"),
     (r"GTest::.*|gtest|gtest_main|gmock", "gtest"),
     (r"Ceres::ceres|ceres", "ceres"),
+    (r"pybind11::.*", "pybind11"),
+    (r"plumb::.*", "plumb_installed"),
 ]
 
 SOURCE_EXTENSIONS = (".h", ".hh", ".hpp", ".hxx", ".inl", ".ipp", ".tpp", ".c", ".cc", ".cpp",
@@ -782,7 +795,7 @@ class CMakeModel:
             if relative:
                 found = [os.path.relpath(f, relative) for f in found]
             variables[words[1]] = ";".join(found)
-        elif name in ("add_library", "add_executable") and words:
+        elif name in ("add_library", "add_executable", "pybind11_add_module") and words:
             target, rest = words[0], words[1:]
             if "IMPORTED" in rest:
                 return

@@ -7,6 +7,7 @@ PACKAGES=(
   libeigen3-dev libopencv-dev libopencv-contrib-dev libpng-dev libdeflate-dev
   libopenni2-dev libv4l-dev libusb-1.0-0-dev
   libgtest-dev libbenchmark-dev
+  python3-dev python3-pybind11 pybind11-dev python3-numpy python3-pytest
 )
 missing=()
 for p in "${PACKAGES[@]}"; do
@@ -14,11 +15,21 @@ for p in "${PACKAGES[@]}"; do
 done
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install_deps: all packages present"
-  exit 0
+else
+  echo "install_deps: installing ${missing[*]}"
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
-echo "install_deps: installing ${missing[*]}"
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+# The independent MAVLink decoder of tests/mavlink_node (npm's node-mavlink, pinned by its
+# package-lock.json), where npm is installed; without it those tests skip.
+here="$(cd "$(dirname "$0")/.." && pwd)"
+if command -v npm >/dev/null 2>&1; then
+  if [ ! -f "$here/tests/mavlink_node/node_modules/node-mavlink/package.json" ]; then
+    npm ci --prefix "$here/tests/mavlink_node" --no-audit --no-fund
+  fi
+else
+  echo "install_deps: npm not found: the MAVLink decoder tests will skip (Debian: apt-get install nodejs npm)"
+fi

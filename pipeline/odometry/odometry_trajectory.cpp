@@ -22,9 +22,9 @@ bool OdometryTrajectory::push(uint64_t sequence, double timestamp_s, bool valid,
   return true;
 }
 
-FinishedFrame OdometryTrajectory::resolve(const LocalMap& map, const Pending& p) {
+FinishedFrame OdometryTrajectory::resolve(const LocalMap& map, const Pending& p) const {
   FinishedFrame out = p.frame;
-  if (p.reference_id == 0) return out;
+  if (p.reference_id == 0 || delay_ == 0) return out;
   for (const LocalMapKeyframe& kf : map.keyframes) {
     if (kf.id == p.reference_id) {
       out.T_world_cam = kf.T_world_cam * p.T_ref_cam;

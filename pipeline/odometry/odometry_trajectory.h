@@ -5,7 +5,9 @@
 // a bounded FIFO for `delay_frames` frames; when a frame leaves the FIFO its pose is
 // T_world_ref * T_ref_cam with the reference keyframe's CURRENT (local-BA refined) pose, so the
 // corrections BA makes after the frame was tracked reach the trajectory. A reference keyframe no
-// longer in the map leaves the pose as tracked. delay_frames = 0 outputs every frame as tracked.
+// longer in the map leaves the pose as tracked. delay_frames = 0 outputs every frame exactly as
+// tracked, a keyframe too (whose own local BA ran before it leaves): what a controller was sent
+// (MAVLink, docs/MAVLINK.md) is then what the trajectory file says.
 #include <array>
 #include <cstdint>
 
@@ -63,7 +65,7 @@ class OdometryTrajectory {
       fn(resolve(map, p));
     }
   }
-  static FinishedFrame resolve(const LocalMap& map, const Pending& p);
+  FinishedFrame resolve(const LocalMap& map, const Pending& p) const;
 
   int delay_;
   std::array<Pending, kMaxDelayFrames> fifo_{};

@@ -127,6 +127,21 @@ CLEAN_TREE = {
         target_include_directories(fuzz_reader PRIVATE ${PLUMB_ROOT} ${OpenCV_INCLUDE_DIRS})
         target_link_libraries(fuzz_reader PRIVATE Eigen3::Eigen ${OpenCV_LIBS})
     """,
+    "api/plumb/odometry.h": "#include <Eigen/Core>\n",
+    "api/odometry.cpp": '#include "api/plumb/odometry.h"\n#include "drivers/dataset/tum.h"\n',
+    "api/python/module.cpp": '#include "api/plumb/odometry.h"\n#include <pybind11/pybind11.h>\n',
+    "api/CMakeLists.txt": """
+        add_library(plumb_api STATIC odometry.cpp)
+        target_link_libraries(plumb_api PUBLIC plumb_drivers plumb_pipeline)
+        pybind11_add_module(plumb_python MODULE python/module.cpp)
+        target_link_libraries(plumb_python PRIVATE plumb_api)
+    """,
+    "examples/embed/main.cpp": "#include <plumb/odometry.h>\n#include <cstdio>\n",
+    "examples/embed/CMakeLists.txt": """
+        find_package(plumb REQUIRED)
+        add_executable(embed main.cpp)
+        target_link_libraries(embed PRIVATE plumb::plumb)
+    """,
     "docs/ARCHITECTURE.md": "# not code\n",
 }
 
@@ -196,6 +211,18 @@ class LayerCheckTest(unittest.TestCase):
         self.append("pipeline/odometry/tracker.cpp", '#include "tools/args.h"\n')
         self.expect_only("pipeline/odometry/tracker.cpp:2:",
                          "pipeline/odometry/ must not include tools/")
+
+    def test_product_includes_api(self):
+        self.append("drivers/dataset/tum.cpp", '#include "api/plumb/odometry.h"\n')
+        self.expect_only("drivers/dataset/tum.cpp:3:", "drivers/ must not include api/")
+
+    def test_example_includes_the_tree(self):
+        self.append("examples/embed/main.cpp", '#include "solver/se3.h"\n')
+        self.expect_only("examples/embed/main.cpp:3:", "examples/ must not include solver/")
+
+    def test_example_links_a_tree_library(self):
+        self.append("examples/embed/CMakeLists.txt", "target_link_libraries(embed PRIVATE plumb_solver)\n")
+        self.expect_only("examples/embed/CMakeLists.txt:", "must not link solver/")
 
     def test_tests_header_from_product(self):
         self.append("drivers/dataset/tum.h", '#include "tests/support/cli.h"\n')

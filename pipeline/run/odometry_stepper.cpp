@@ -1,0 +1,52 @@
+#include "pipeline/run/odometry_stepper.h"
+
+#include <opencv2/core/utility.hpp>
+
+namespace plumb {
+
+OdometryStepper::OdometryStepper(OdometrySystem& system, OdometrySink& sink)
+    : system_(system),
+      sink_(sink),
+      extract_(system),
+      track_(system, fence_, sink),
+      // Warm-up far away: the allocation bookkeeping is the runner's; callers measure themselves.
+      map_(system, fence_, drops_, sink, UINT64_MAX) {
+  cv::setNumThreads(0);
+  const PinholeCamera& camera = system.camera();
+  slot_.image.bgr.create(camera.height, camera.width, CV_8UC3);
+  slot_.image.depth_raw.create(camera.height, camera.width, CV_16UC1);
+  slot_.image.depth_factor = camera.depth_factor;
+}
+
+Status OdometryStepper::step() {
+  if (finished_) return Status::Error("odometry stepper: step() after finish()");
+  runtime::FrameStamps stamps;
+  stamps.frame_index = frames_;
+  stamps.t_recorded_ns = int64_t(slot_.image.timestamp_s * 1e9);
+  slot_.image.sequence = frames_;
+  slot_.dropped_before = 0;
+  ++frames_;
+  // The runner's lock-step order (runtime::StageRunner in deterministic mode).
+  PLUMB_RETURN_IF_ERROR(extract_.process(slot_, stamps));
+  PLUMB_RETURN_IF_ERROR(track_.process(slot_, stamps));
+  PLUMB_RETURN_IF_ERROR(map_.process(slot_, stamps));
+  // A loop-closing stage goes here, after map_, on the same slot.
+  return Status::Ok();
+}
+
+Status OdometryStepper::finish() {
+  if (finished_) return Status::Ok();
+  finished_ = true;
+  map_.finish();
+  Status status = map_.finishStatus();
+  system_.finish(
+      [&](const FinishedFrame& f) {
+        if (status.ok()) status = sink_.onFinishedFrame(f);
+      },
+      [&](const RetiredKeyframe& kf) {
+        if (status.ok()) status = sink_.onRetiredKeyframe(kf);
+      });
+  return status;
+}
+
+}  // namespace plumb

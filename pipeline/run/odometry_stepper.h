@@ -1,0 +1,57 @@
+#pragma once
+// OdometryStepper: push-style odometry for callers that own their frame loop (the public API,
+// api/plumb/odometry.h). It runs THE stage objects of runOdometry() (pipeline/run/odometry_stages.h:
+// ExtractStage, TrackStage, MapStage) over one OdometrySlot, lock-step, one frame per step(): the
+// same calls in the same order as the deterministic mode of the runner, so the same frames give the
+// same poses, byte for byte. No second implementation of anything: only the capture stage is
+// replaced by the caller writing the frame into slot().image.
+//
+//   OdometryStepper stepper(system, sink);   // allocates the slot and the extractor, once
+//   RgbdImage& image = stepper.slot().image;  // fill bgr / depth_raw / timestamp_s in place
+//   stepper.step();                           // extract -> track (sink.onPose) -> map (sink.on*)
+//   ...
+//   stepper.finish();                         // every held-back pose reaches the sink
+//
+// After warm-up a step allocates nothing (as the runner's stages; tests/api checks it).
+// A loop-closing stage (pipeline/loop) joins the same way the runner adds it: one more process()
+// call after map_ in step(), over the same slot.
+#include <cstdint>
+
+#include "pipeline/odometry/mapper_fence.h"
+#include "pipeline/run/odometry_run.h"
+#include "pipeline/run/odometry_stages.h"
+#include "platform/status.h"
+
+namespace plumb {
+
+class OdometryStepper {
+ public:
+  // `system` and `sink` must outlive the stepper. Sets OpenCV to no worker threads, as the runner
+  // does (process-wide): the stages are the parallelism and the output must not depend on a pool.
+  OdometryStepper(OdometrySystem& system, OdometrySink& sink);
+
+  // The frame to fill before step(): write bgr (CV_8UC3, camera size), depth_raw (CV_16UC1) and
+  // timestamp_s; sequence and the stamps are set by step().
+  OdometrySlot& slot() { return slot_; }
+  // One frame through extract, track and map. The tracked result is slot().tracked->output.
+  Status step();
+  // End of input: every pose held back for refinement and every keyframe reach the sink.
+  Status finish();
+
+  uint64_t frames() const { return frames_; }
+  uint64_t extractionFailures() const { return extract_.failures(); }
+
+ private:
+  OdometrySystem& system_;
+  OdometrySink& sink_;
+  OdometrySlot slot_;
+  DropLog drops_;        // stays empty: nothing is dropped when the caller pushes frames
+  MapperFence fence_{false};  // lock-step: never waits
+  ExtractStage extract_;
+  TrackStage track_;
+  MapStage map_;
+  uint64_t frames_ = 0;
+  bool finished_ = false;
+};
+
+}  // namespace plumb
