@@ -200,6 +200,6 @@ int benchMain(int argc, char** argv) {
 
 }  // namespace
 
-PLUMB_COMMAND(bench, "benchmarks: `plumb bench frontend --dataset DIR` (front end), `plumb bench instructions`", benchMain);
+PLUMB_COMMAND(bench, "benchmarks: `plumb bench frontend --dataset DIR` (front end; instructions per stage: bench/instructions/)", benchMain);
 
 }  // namespace plumb::tools
