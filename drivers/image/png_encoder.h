@@ -29,10 +29,12 @@ struct PngEncodeOptions {
   bool sub_filter_only = false;
 };
 
-// The settings of `cv::imwrite(path, image)` without parameters (SUB filter, level 1).
+// The settings of `cv::imwrite(path, image)` without parameters (OpenCV 4: SUB filter, level 1,
+// run-length strategy).
 inline PngEncodeOptions pngFastestOptions() {
   PngEncodeOptions options;
   options.sub_filter_only = true;
+  options.rle_strategy = true;
   return options;
 }
 
