@@ -106,6 +106,8 @@ def header_family(name):
         return "png"
     if name == "libdeflate.h":
         return "libdeflate"
+    if name == "jpeglib.h":
+        return "jpeg"
     if name in ("OpenNI.h", "openni2/OpenNI.h"):
         return "openni2"
     if name in ("libusb.h", "libusb-1.0/libusb.h"):
@@ -121,7 +123,7 @@ def header_family(name):
     return None
 
 
-_ALL_THIRD_PARTY = ["std", "posix", "eigen", "opencv_core", "opencv", "png", "libdeflate",
+_ALL_THIRD_PARTY = ["std", "posix", "eigen", "opencv_core", "opencv", "png", "jpeg", "libdeflate",
                     "openni2", "libusb"]
 ALLOWED_FAMILIES = {
     "platform": ["std", "posix"],
@@ -150,6 +152,7 @@ LINK_FAMILIES = [
     (r"Threads::Threads|pthread|rt|dl|\$\{CMAKE_THREAD_LIBS_INIT\}", "posix"),
     (r"m", "std"),
     (r"PNG::PNG|png", "png"),
+    (r"JPEG::JPEG|jpeg", "jpeg"),
     (r"PkgConfig::LIBDEFLATE|deflate", "libdeflate"),
     (r"PkgConfig::OPENNI2|OpenNI2", "openni2"),
     (r"PkgConfig::LIBUSB|usb-1\.0", "libusb"),

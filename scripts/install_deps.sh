@@ -6,9 +6,13 @@ PACKAGES=(
   build-essential cmake pkg-config
   libeigen3-dev libopencv-dev libopencv-contrib-dev libpng-dev libdeflate-dev
   libopenni2-dev libv4l-dev libusb-1.0-0-dev
+  libjpeg62-turbo-dev
   libgtest-dev libbenchmark-dev
   python3-dev python3-pybind11 pybind11-dev python3-numpy python3-pytest
+  valgrind
 )
+# libjpeg62-turbo-dev: MJPEG cameras and JPEG images in TUM folders (optional at build time).
+# valgrind: ctest instruction_budget (bench/instructions/; skipped without it).
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -66,6 +66,7 @@
 #include "solver/camera_intrinsics.h"
 #include "solver/robust_kernel.h"
 #include "solver/types.h"
+#include "solver/zero_page_allocator.h"
 
 namespace plumb {
 
@@ -221,7 +222,8 @@ class LocalBundleAdjuster {
   CameraIntrinsics camera_;
   std::vector<Keyframe> keyframes_;
   std::vector<Landmark> landmarks_;
-  std::vector<Observation> observations_;
+  // Reserved for the worst case, written from the front: untouched slots stay out of RSS.
+  std::vector<Observation, ZeroPageAllocator<Observation>> observations_;
   std::vector<int> observation_order_;  // observation indices grouped by landmark
   std::vector<int> landmark_scratch_;   // one landmark's observations in free keyframes
   std::vector<int> variable_keyframe_;  // pose variable -> keyframe

@@ -1,9 +1,10 @@
 // plumb bench frontend: per-frame cost of the measurement front end (ORB, lines + LBD, depth +
-// line-guidance sampling) on a TUM-layout sequence, single thread, next to the stock OpenCV path
-// (cv::ORB 1000/8/1.2 + line_descriptor::LSDDetector + BinaryDescriptor) on the same frames.
-// Prints median / p99 per stage; the last two lines are the machine-readable summary:
+// line-guidance sampling) on a TUM-layout sequence, single thread. Prints median / p99 per stage;
+// the last line is the machine-readable summary:
 //   frontend_ms_median X
-//   stock_opencv_ms_median Y
+// The comparison with the stock OpenCV path (cv::ORB + line_descriptor) is the separate program
+// build/bin/plumb_bench_stock_frontend (bench/frontend/), so that `plumb` does not link
+// features2d and line_descriptor (docs/EMBEDDED.md).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -13,9 +14,6 @@
 #include <vector>
 
 #include <opencv2/core.hpp>
-#include <opencv2/features2d.hpp>
-#include <opencv2/imgproc.hpp>
-#include <opencv2/line_descriptor.hpp>
 
 #include "drivers/dataset/camera_presets.h"
 #include "drivers/dataset/tum_dataset.h"
@@ -49,51 +47,19 @@ struct Series {
 
 void printUsage() {
   std::printf(
-      "usage: plumb bench frontend --dataset DIR [--camera tum1] [--frames N] [--no-stock]\n"
+      "usage: plumb bench frontend --dataset DIR [--camera tum1] [--frames N]\n"
       "                            [--line-level L] [--line-samples N] [--opencv-lsd] [--clock wall|cpu]\n"
       "                            [--dump FILE] [--repeat N]\n"
       "  Runs the front end (pipeline/frontend/feature_extractor.h) with default ExtractorOptions on every\n"
-      "  frame of a TUM-layout folder, single thread, then the stock OpenCV path on the same frame.\n"
-      "  --clock: what the two summary lines report: wall (steady clock, default) or cpu (this\n"
+      "  frame of a TUM-layout folder, single thread. The stock OpenCV comparison (cv::ORB +\n"
+      "  line_descriptor) is build/bin/plumb_bench_stock_frontend --dataset DIR (bench/frontend/).\n"
+      "  --clock: what the summary line reports: wall (steady clock, default) or cpu (this\n"
       "  thread's CPU time, which does not count waiting for a core on a loaded machine).\n"
       "  --dump: write every extracted feature (keypoints, descriptors, lines, samples) as text, so\n"
       "  a speed change can be checked to leave the output bit-identical (diff two dumps).\n"
       "  --repeat: extract every frame N times and keep, per stage, the fastest run (for A/B\n"
       "  comparisons on a loaded machine; the default 1 is the honest single-run number).\n");
 }
-
-// The stock path the issue compares against: cv::ORB 1000 features, 8 levels, 1.2, and the contrib
-// LSDDetector + BinaryDescriptor (LBD) on every detected line.
-struct StockPath {
-  cv::Ptr<cv::ORB> orb = cv::ORB::create(1000, 1.2f, 8);
-  cv::Ptr<cv::line_descriptor::LSDDetector> lsd = cv::line_descriptor::LSDDetector::createLSDDetector();
-  cv::Ptr<cv::line_descriptor::BinaryDescriptor> lbd = cv::line_descriptor::BinaryDescriptor::createBinaryDescriptor();
-  std::vector<cv::KeyPoint> keypoints;
-  cv::Mat descriptors, line_descriptors, grey;
-  std::vector<cv::line_descriptor::KeyLine> keylines;
-  double orb_ms = 0, lsd_ms = 0, lbd_ms = 0;              // wall
-  double orb_cpu_ms = 0, lsd_cpu_ms = 0, lbd_cpu_ms = 0;  // thread CPU time
-
-  void run(const cv::Mat& bgr) {
-    cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
-    auto t = Clock::now();
-    double cpu = threadCpuMs();
-    orb->detectAndCompute(grey, cv::noArray(), keypoints, descriptors);
-    orb_ms = msSince(t);
-    orb_cpu_ms = threadCpuMs() - cpu;
-    t = Clock::now();
-    cpu = threadCpuMs();
-    keylines.clear();
-    lsd->detect(grey, keylines, 2, 1);
-    lsd_ms = msSince(t);
-    lsd_cpu_ms = threadCpuMs() - cpu;
-    t = Clock::now();
-    cpu = threadCpuMs();
-    lbd->compute(grey, keylines, line_descriptors);
-    lbd_ms = msSince(t);
-    lbd_cpu_ms = threadCpuMs() - cpu;
-  }
-};
 
 // One line per feature, floats as hex so "identical" means bit-identical.
 void dumpFeatures(std::FILE* f, size_t frame, const FrameFeatures& features) {
@@ -155,22 +121,16 @@ int benchFrontend(int argc, char** argv) {
   }
   FeatureExtractor extractor(camera, options);
   auto features = std::make_unique<FrameFeatures>();
-  StockPath stock;
   std::FILE* dump = nullptr;
   if (args.has("dump")) {
     dump = std::fopen(args.get("dump").c_str(), "w");
     if (dump == nullptr) { std::fprintf(stderr, "plumb bench frontend: cannot write %s\n", args.get("dump").c_str()); return 1; }
   }
-  const bool run_stock = !args.has("no-stock");
 
   Series orb{"ORB", {}}, lines{"lines + LBD", {}}, depth{"depth + sampling", {}}, total{"frontend total", {}};
   Series cpu_orb{"ORB (CPU)", {}}, cpu_lines{"lines + LBD (CPU)", {}}, cpu_depth{"depth + sampling (CPU)", {}};
-  Series cpu_total{"frontend total (CPU)", {}}, s_cpu_total{"stock total (CPU)", {}};
-  Series s_orb{"stock cv::ORB", {}}, s_lsd{"stock LSDDetector", {}}, s_lbd{"stock BinaryDescriptor", {}},
-      s_total{"stock total", {}};
-  Series s_cpu_orb{"stock cv::ORB (CPU)", {}}, s_cpu_lsd{"stock LSDDetector (CPU)", {}},
-      s_cpu_lbd{"stock BinaryDesc. (CPU)", {}};
-  double sum_kp = 0, sum_kp_depth = 0, sum_lines = 0, sum_lines3d = 0, sum_stock_lines = 0;
+  Series cpu_total{"frontend total (CPU)", {}};
+  double sum_kp = 0, sum_kp_depth = 0, sum_lines = 0, sum_lines3d = 0;
   RgbdImage frame;
   const size_t n = max_frames > 0 ? std::min<size_t>(source->size(), max_frames) : source->size();
   for (size_t i = 0; i < n; ++i) {
@@ -209,20 +169,6 @@ int benchFrontend(int argc, char** argv) {
     sum_kp_depth += t.num_keypoints_with_depth;
     sum_lines += t.num_lines;
     sum_lines3d += t.num_lines_3d;
-    if (run_stock) {
-      const auto t0 = Clock::now();
-      const double cpu0 = threadCpuMs();
-      stock.run(frame.bgr);
-      s_total.ms.push_back(msSince(t0));
-      s_cpu_total.ms.push_back(threadCpuMs() - cpu0);
-      s_orb.ms.push_back(stock.orb_ms);
-      s_lsd.ms.push_back(stock.lsd_ms);
-      s_lbd.ms.push_back(stock.lbd_ms);
-      s_cpu_orb.ms.push_back(stock.orb_cpu_ms);
-      s_cpu_lsd.ms.push_back(stock.lsd_cpu_ms);
-      s_cpu_lbd.ms.push_back(stock.lbd_cpu_ms);
-      sum_stock_lines += stock.keylines.size();
-    }
   }
   if (dump != nullptr) std::fclose(dump);
   const double frames = std::max<size_t>(n, 1);
@@ -237,24 +183,12 @@ int benchFrontend(int argc, char** argv) {
   cpu_lines.print();
   cpu_depth.print();
   cpu_total.print();
-  if (run_stock) {
-    std::printf("  stock path: %.0f lines described per frame\n", sum_stock_lines / frames);
-    s_orb.print();
-    s_lsd.print();
-    s_lbd.print();
-    s_total.print();
-    s_cpu_orb.print();
-    s_cpu_lsd.print();
-    s_cpu_lbd.print();
-    s_cpu_total.print();
-    std::printf("  speed-up (stock / frontend, medians): wall %.1fx, CPU %.1fx\n",
-                s_total.percentile(0.5) / total.percentile(0.5), s_cpu_total.percentile(0.5) / cpu_total.percentile(0.5));
-    std::printf("  (wall = steady clock; CPU = this thread's CPU time, which excludes waiting for a core)\n");
-  }
+  std::printf("  stock OpenCV comparison (cv::ORB + line_descriptor): build/bin/plumb_bench_stock_frontend\n"
+              "  --dataset %s (a separate program, so that plumb does not link those libraries)\n",
+              args.get("dataset").c_str());
   const bool cpu = clock == "cpu";
   std::printf("summary clock: %s\n", cpu ? "thread CPU time" : "wall (steady clock)");
   std::printf("frontend_ms_median %.2f\n", (cpu ? cpu_total : total).percentile(0.5));
-  if (run_stock) std::printf("stock_opencv_ms_median %.2f\n", (cpu ? s_cpu_total : s_total).percentile(0.5));
   return 0;
 }
 
@@ -266,6 +200,6 @@ int benchMain(int argc, char** argv) {
 
 }  // namespace
 
-PLUMB_COMMAND(bench, "benchmarks: `plumb bench frontend --dataset DIR` (front end vs stock OpenCV)", benchMain);
+PLUMB_COMMAND(bench, "benchmarks: `plumb bench frontend --dataset DIR` (front end; instructions per stage: bench/instructions/)", benchMain);
 
 }  // namespace plumb::tools

@@ -7,9 +7,9 @@
 #include <string>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "drivers/image/png_encoder.h"
 #include "runtime/chrome_trace.h"
 #include "runtime/run_report.h"
 #include "tools/args.h"
@@ -102,12 +102,7 @@ Status drawHistograms(const runtime::RunReport& report, const std::string& path)
     drawPanel(canvas, i * kPanelHeight, report.stages[i].name, report.stages[i].latency, first, last);
   }
   drawPanel(canvas, (panels - 1) * kPanelHeight, "end-to-end", report.end_to_end, first, last);
-  try {
-    if (!cv::imwrite(path, canvas)) return Status::Error("cannot write " + path);
-  } catch (const cv::Exception& e) {
-    return Status::Error("cannot write " + path + ": " + e.what());
-  }
-  return Status::Ok();
+  return writePngFile(path, canvas, pngFastestOptions());
 }
 
 int profileCommand(int argc, char** argv) {

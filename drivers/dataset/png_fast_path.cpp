@@ -168,3 +168,11 @@ bool PngFastPath::decode(const uint8_t* bytes, std::size_t size, int bit_depth, 
 }  // namespace plumb
 
 #endif  // PLUMB_HAVE_LIBDEFLATE
+
+#ifndef PLUMB_HAVE_LIBDEFLATE
+namespace plumb {
+// Without libdeflate PngDecoder never creates a fast path, but its unique_ptr still needs these.
+PngFastPath::PngFastPath() = default;
+PngFastPath::~PngFastPath() = default;
+}  // namespace plumb
+#endif

@@ -9,10 +9,10 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
-#include <opencv2/imgcodecs.hpp>
 
 #include "drivers/dataset/png_decoder.h"
 #include "drivers/dataset/tum_lists.h"
+#include "drivers/image/jpeg_decoder.h"
 
 namespace plumb {
 namespace {
@@ -135,14 +135,12 @@ Status TumDatasetSource::loadImage(const std::string& path, bool is_depth, cv::M
   if (size >= 8 && std::memcmp(file_bytes_.data(), "\x89PNG\r\n\x1a\n", 8) == 0) {
     return Status::Error(path + ": " + png_->error());  // a PNG libpng rejected
   }
-  // Another format (e.g. a JPEG colour stream): OpenCV, which allocates per image. IMREAD_UNCHANGED
-  // keeps the stored bit depth so an 8-bit depth map is caught, not converted.
-  try {
-    cv::imdecode(cv::Mat(1, static_cast<int>(size), CV_8UC1, file_bytes_.data()), cv::IMREAD_UNCHANGED, &dst);
-  } catch (const cv::Exception& e) {
-    return Status::Error(path + ": cannot decode image (" + e.what() + ")");
-  }
-  if (dst.empty()) return Status::Error(path + ": corrupt, truncated or not an image");
+  // A JPEG colour stream (some converted datasets store rgb/*.jpg): libjpeg, which allocates per
+  // image. Grey JPEGs stay one channel so that a JPEG depth map is caught below, not converted.
+  if (!looksLikeJpeg(file_bytes_.data(), size))
+    return Status::Error(path + ": corrupt, truncated or not an image (plumb reads PNG and JPEG)");
+  std::string error;
+  if (!decodeJpeg(file_bytes_.data(), size, dst, &error)) return Status::Error(path + ": " + error);
   const std::string problem = imageProblem(dst.type(), dst.cols, dst.rows, is_depth, camera_);
   if (!problem.empty()) return Status::Error(path + ": " + problem);
   return Status::Ok();

@@ -12,8 +12,8 @@
 //
 // Buffers: image files are read into a reused byte buffer (POSIX read) and PNGs decoded by libpng
 // straight into the caller's RgbdImage Mats (PngDecoder, its structures in a fixed arena), so a
-// replayed frame allocates nothing once the Mats have their size. Other formats fall back to
-// cv::imdecode (allocates per image).
+// replayed frame allocates nothing once the Mats have their size. JPEG colour images are decoded
+// by libjpeg (drivers/image/jpeg_decoder.h; allocates per image); other formats are an error.
 #include <cstddef>
 #include <memory>
 #include <string>

@@ -1,7 +1,7 @@
 #pragma once
 // Lossless image payloads of a recording frame chunk: raw rows or PNG (see ImageCodec).
 // Encoders append to a reused byte buffer; decoders fill caller-owned Mats, which are reused when
-// the size matches (PNG decoding still allocates inside libpng: replay is not allocation-free).
+// the size matches (PNG decoding uses a per-thread PngDecoder whose arena is reused).
 #include <cstddef>
 #include <cstdint>
 #include <vector>

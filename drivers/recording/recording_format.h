@@ -37,7 +37,7 @@ enum class ChunkType : uint32_t { kFrame = 1, kIndex = 2, kEnd = 3 };
 // How an image is stored inside a frame chunk. Both are lossless.
 enum class ImageCodec : uint8_t {
   kRaw = 0,  // rows top to bottom, no padding: BGR bytes, or uint16 little-endian depth
-  kPng = 1,  // PNG (8-bit BGR colour, 16-bit grey depth) via cv::imencode
+  kPng = 1,  // PNG (8-bit BGR colour, 16-bit grey depth) via libpng (drivers/image/png_encoder.h)
 };
 
 constexpr std::size_t kFramePayloadFixedSize = 64;

@@ -3,9 +3,9 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include <opencv2/imgcodecs.hpp>
 
 #include "drivers/dataset/camera_file.h"
+#include "drivers/image/png_encoder.h"
 
 namespace plumb {
 namespace {
@@ -59,11 +59,10 @@ Status TumFolderWriter::append(const RgbdImage& frame) {
   const std::string rgb_name = "rgb/" + rgb_t + ".png";
   const std::string depth_name = "depth/" + depth_t + ".png";
   // Lossless PNG both ways; level 1 keeps conversion fast.
-  const std::vector<int> params = {cv::IMWRITE_PNG_COMPRESSION, 1};
-  if (!cv::imwrite(dir_ + "/" + rgb_name, frame.bgr, params))
-    return Status::Error(dir_ + "/" + rgb_name + ": cannot write");
-  if (!cv::imwrite(dir_ + "/" + depth_name, frame.depth_raw, params))
-    return Status::Error(dir_ + "/" + depth_name + ": cannot write");
+  PngEncodeOptions png;
+  png.compression_level = 1;
+  PLUMB_RETURN_IF_ERROR(writePngFile(dir_ + "/" + rgb_name, frame.bgr, png));
+  PLUMB_RETURN_IF_ERROR(writePngFile(dir_ + "/" + depth_name, frame.depth_raw, png));
   std::fprintf(rgb_list_, "%s %s\n", rgb_t.c_str(), rgb_name.c_str());
   std::fprintf(depth_list_, "%s %s\n", depth_t.c_str(), depth_name.c_str());
   std::fprintf(associations_, "%s %s %s %s\n", rgb_t.c_str(), rgb_name.c_str(), depth_t.c_str(),

@@ -4,9 +4,9 @@
 #include <system_error>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
 
 #include "drivers/dataset/camera_file.h"
+#include "drivers/image/png_encoder.h"
 #include "drivers/synth/synthetic_scene.h"
 #include "drivers/trajectory/trajectory_io.h"
 
@@ -37,13 +37,8 @@ Status writeTextFile(const std::filesystem::path& path, const std::string& text)
 }
 
 Status writePng(const std::filesystem::path& path, const cv::Mat& image) {
-  bool ok = false;
-  try {
-    ok = cv::imwrite(path.string(), image);
-  } catch (const cv::Exception& e) {
-    return Status::Error(path.string() + ": cannot write PNG (" + e.what() + ")");
-  }
-  return ok ? Status::Ok() : Status::Error(path.string() + ": cannot write PNG");
+  // The settings of cv::imwrite without parameters, which wrote these files before.
+  return writePngFile(path.string(), image, pngFastestOptions());
 }
 
 }  // namespace

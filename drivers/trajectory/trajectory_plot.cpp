@@ -5,8 +5,9 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+
+#include "drivers/image/png_encoder.h"
 
 namespace plumb {
 namespace {
@@ -200,13 +201,8 @@ Status writeTrajectoryPlot(const std::string& png_path, const AteResult& ate,
   errors.area = cv::Rect(left, error_top, usable_width, error_height);
   drawErrorsOverTime(image, errors, ate);
 
-  bool written = false;
-  try {
-    written = cv::imwrite(png_path, image);
-  } catch (const cv::Exception& e) {
-    return Status::Error(png_path + ": cannot write plot (" + e.err + ")");
-  }
-  if (!written) return Status::Error(png_path + ": cannot write plot (missing folder or no permission?)");
+  const Status written = writePngFile(png_path, image, pngFastestOptions());
+  if (!written.ok()) return Status::Error("cannot write plot: " + written.message());
   return Status::Ok();
 }
 

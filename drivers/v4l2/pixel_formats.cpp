@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include <opencv2/imgcodecs.hpp>
+#include "drivers/image/jpeg_decoder.h"
 
 namespace plumb {
 namespace {
@@ -55,13 +55,8 @@ bool mjpegToBgr(const uint8_t* src, std::size_t size, int width, int height, cv:
   std::size_t end = size;
   while (end > 0 && src[end - 1] == 0) --end;
   if (end < 4 || src[end - 2] != 0xFF || src[end - 1] != 0xD9) return false;
-  const cv::Mat encoded(1, static_cast<int>(size), CV_8UC1, const_cast<uint8_t*>(src));
-  try {
-    cv::imdecode(encoded, cv::IMREAD_COLOR, &bgr);
-  } catch (const cv::Exception&) {
-    return false;
-  }
-  return !bgr.empty() && bgr.cols == width && bgr.rows == height;
+  if (!decodeJpeg(src, end, bgr, nullptr)) return false;
+  return bgr.type() == CV_8UC3 && bgr.cols == width && bgr.rows == height;
 }
 
 }  // namespace plumb

@@ -1,7 +1,8 @@
 #pragma once
 // Conversions from V4L2 buffer layouts to plumb's frame images. Destinations are created once
 // (same size every frame) and then reused, so steady-state conversion does not allocate, except
-// MJPEG, whose decoder (libjpeg via cv::imdecode) allocates internally.
+// MJPEG, whose decoder (libjpeg, drivers/image/jpeg_decoder.h) allocates internally. Without
+// libjpeg at build time MJPEG frames are refused (mjpegToBgr returns false).
 #include <cstddef>
 #include <cstdint>
 
