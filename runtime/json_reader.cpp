@@ -45,8 +45,11 @@ class Parser {
                          std::to_string(column) + ": " + what);
   }
 
+  // RFC 8259 whitespace only (not strchr(" \t\r\n", c): that also matches a NUL byte).
+  static bool isWhitespace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+
   void skipWhitespace() {
-    while (pos_ < text_.size() && std::strchr(" \t\r\n", text_[pos_]) != nullptr) ++pos_;
+    while (pos_ < text_.size() && isWhitespace(text_[pos_])) ++pos_;
   }
 
   bool consume(char c) {

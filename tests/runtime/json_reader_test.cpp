@@ -39,5 +39,16 @@ TEST(JsonReader, RefusesHostileNesting) {
   EXPECT_FALSE(parseJson(std::string(100000, '['), &v).ok());
 }
 
+// Found by fuzz/json_reader_fuzzer.cpp (differential against the RFC 8259 grammar): a NUL byte was
+// skipped as whitespace, because strchr(" \t\r\n", c) also matches the terminating NUL.
+TEST(JsonReader, RefusesNulBytesOutsideStrings) {
+  JsonValue v;
+  for (const std::string bad : {std::string("[1,\0 2]", 7), std::string("\0{}", 3), std::string("{}\0", 3),
+                                std::string("{\"a\":\0 1}", 9)}) {
+    EXPECT_FALSE(parseJson(bad, &v).ok()) << "accepted a NUL byte at offset " << bad.find('\0');
+  }
+  EXPECT_TRUE(parseJson(" \t\r\n[1, 2]\n", &v).ok());
+}
+
 }  // namespace
 }  // namespace plumb::runtime
