@@ -105,7 +105,10 @@ class Parser {
       return pos_ > from;
     };
     if (text_[pos_] == '-') ++pos_;
+    // int = "0" / nonzero digit *digit: "01" is not JSON.
+    const std::size_t int_start = pos_;
     if (!digits()) return error("malformed number");
+    if (text_[int_start] == '0' && pos_ - int_start > 1) return error("malformed number: leading zero");
     if (pos_ < text_.size() && text_[pos_] == '.') {
       ++pos_;
       if (!digits()) return error("malformed number: digits expected after '.'");

@@ -50,5 +50,20 @@ TEST(JsonReader, RefusesNulBytesOutsideStrings) {
   EXPECT_TRUE(parseJson(" \t\r\n[1, 2]\n", &v).ok());
 }
 
+// Found by the fuzzer: RFC 8259 numbers have no leading zeros ("01" is not JSON).
+TEST(JsonReader, RefusesLeadingZeros) {
+  JsonValue v;
+  for (const char* bad : {"01", "-01", "[00]", "{\"a\": 007.5}", "00e1"}) {
+    EXPECT_FALSE(parseJson(bad, &v).ok()) << "accepted: " << bad;
+  }
+  for (const char* good : {"0", "-0", "0.5", "0e3", "10", "[0, 100]"}) {
+    EXPECT_TRUE(parseJson(good, &v).ok()) << "refused: " << good;
+  }
+  ASSERT_TRUE(parseJson("[-0.25, 0E-2, 120]", &v).ok());
+  EXPECT_EQ(v.items[0].number, -0.25);
+  EXPECT_EQ(v.items[1].number, 0.0);
+  EXPECT_EQ(v.items[2].number, 120.0);
+}
+
 }  // namespace
 }  // namespace plumb::runtime
