@@ -123,6 +123,13 @@ class Parser {
     return Status::Ok();
   }
 
+  static int hexDigit(char c) {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return -1;
+  }
+
   static void appendUtf8(unsigned code, std::string* out) {
     if (code < 0x80) {
       out->push_back(static_cast<char>(code));
@@ -160,10 +167,13 @@ class Parser {
         case 't': out->push_back('\t'); break;
         case 'u': {
           if (pos_ + 4 > text_.size()) return error("truncated \\u escape");
-          char* end = nullptr;
-          const std::string hex = text_.substr(pos_, 4);
-          const unsigned code = static_cast<unsigned>(std::strtoul(hex.c_str(), &end, 16));
-          if (end != hex.c_str() + 4) return error("malformed \\u escape");
+          // Exactly four hex digits (strtoul would also take a sign, spaces or "0x").
+          unsigned code = 0;
+          for (int k = 0; k < 4; ++k) {
+            const int digit = hexDigit(text_[pos_ + k]);
+            if (digit < 0) return error("malformed \\u escape");
+            code = code * 16 + static_cast<unsigned>(digit);
+          }
           pos_ += 4;
           appendUtf8(code, out);  // surrogate pairs are kept as two code units; names are ASCII
           break;

@@ -65,5 +65,16 @@ TEST(JsonReader, RefusesLeadingZeros) {
   EXPECT_EQ(v.items[2].number, 120.0);
 }
 
+// Found by the fuzzer: \u must be followed by exactly four hex digits; strtoul also took a sign,
+// spaces and a "0x" prefix ("\u-001" even produced the byte 0xFF, which is never UTF-8).
+TEST(JsonReader, UnicodeEscapeNeedsFourHexDigits) {
+  JsonValue v;
+  for (const char* bad : {R"("\u0x12")", R"("\u+123")", R"("\u 123")", R"("\u-001")", R"("\u12g4")", R"("\u12")"}) {
+    EXPECT_FALSE(parseJson(bad, &v).ok()) << "accepted: " << bad;
+  }
+  ASSERT_TRUE(parseJson(R"("\u0041\u00e9\u20AC")", &v).ok());
+  EXPECT_EQ(v.string, "A\xc3\xa9\xe2\x82\xac");
+}
+
 }  // namespace
 }  // namespace plumb::runtime
