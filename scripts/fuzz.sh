@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Builds every libFuzzer target (fuzz/, clang + ASan + UBSan) into build-fuzz and runs each for
 # SECONDS (default 60) on a temporary copy of its seed corpus (fuzz/corpus/<target>/; the tree is
-# not modified). Prints per target: executions, exec/s, coverage (cov: edges, ft: features),
-# corpus size, and any crash (its input is kept in build-fuzz/artifacts/<target>/).
+# not modified), with fuzz/dict/<target>.dict when there is one. Prints per target: executions,
+# exec/s, coverage (cov: edges, ft: features), corpus size, and any crash (its input is kept in
+# build-fuzz/artifacts/<target>/).
 # Exit status 1 when any target crashed or broke an invariant, 2 when clang/libFuzzer is missing.
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     e.g. scripts/fuzz.sh 600 png_decoder
 set -uo pipefail
@@ -36,8 +37,10 @@ for t in "${TARGETS[@]}"; do
   work="$probe/$t"
   mkdir -p "$work/corpus" "build-fuzz/artifacts/$t"
   cp fuzz/corpus/"$t"/* "$work/corpus/"
+  dict=()
+  [ -f "fuzz/dict/$t.dict" ] && dict=(-dict="fuzz/dict/$t.dict")
   ./build-fuzz/fuzz_"$t" -max_total_time="$SECONDS_PER_TARGET" -print_final_stats=1 -timeout=10 \
-    -artifact_prefix="build-fuzz/artifacts/$t/" "$work/corpus" >"$work/log" 2>&1
+    "${dict[@]}" -artifact_prefix="build-fuzz/artifacts/$t/" "$work/corpus" >"$work/log" 2>&1
   rc=$?
   # The last status line ("#N DONE cov: C ft: F corp: K/B ...") holds the final coverage.
   status=$(grep -E '^#[0-9]+' "$work/log" | tail -1)
