@@ -7,6 +7,7 @@ PACKAGES=(
   libeigen3-dev libopencv-dev libopencv-contrib-dev libpng-dev libdeflate-dev
   libopenni2-dev libv4l-dev libusb-1.0-0-dev
   libgtest-dev libbenchmark-dev
+  clang libclang-rt-14-dev  # fuzz targets (scripts/fuzz.sh): libFuzzer is in libclang-rt-14-dev
 )
 missing=()
 for p in "${PACKAGES[@]}"; do
