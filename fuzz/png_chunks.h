@@ -101,21 +101,48 @@ inline int samplesPerPixel(int colour_type) {
   }
 }
 
-// Bytes of the filtered scanlines (filter byte + packed row) the IHDR implies; 0 if invalid.
-inline std::size_t filteredSize(const PngLayout& l) {
-  const std::size_t bits_per_pixel = std::size_t(samplesPerPixel(l.colour_type)) * std::size_t(l.bit_depth);
-  if (bits_per_pixel == 0) return 0;
-  auto rows = [&](std::size_t w, std::size_t h) { return w == 0 || h == 0 ? 0 : h * (1 + (w * bits_per_pixel + 7) / 8); };
-  if (l.interlace == 0) return rows(l.width, l.height);
+// The (width, height) of each sub-image the IHDR implies: one, or Adam7's seven passes.
+template <typename PassFn>
+void forEachPass(const PngLayout& l, PassFn pass) {
+  if (l.interlace == 0) {
+    pass(std::size_t(l.width), std::size_t(l.height));
+    return;
+  }
   static const int kStart[7][2] = {{0, 0}, {4, 0}, {0, 4}, {2, 0}, {0, 2}, {1, 0}, {0, 1}};
   static const int kStep[7][2] = {{8, 8}, {8, 8}, {4, 8}, {4, 4}, {2, 4}, {2, 2}, {1, 2}};
-  std::size_t total = 0;
   for (int p = 0; p < 7; ++p) {
     const std::size_t w = l.width > uint32_t(kStart[p][0]) ? (l.width - kStart[p][0] + kStep[p][0] - 1) / kStep[p][0] : 0;
     const std::size_t h = l.height > uint32_t(kStart[p][1]) ? (l.height - kStart[p][1] + kStep[p][1] - 1) / kStep[p][1] : 0;
-    total += rows(w, h);
+    pass(w, h);
   }
+}
+
+inline std::size_t bitsPerPixel(const PngLayout& l) {
+  return std::size_t(samplesPerPixel(l.colour_type)) * std::size_t(l.bit_depth);
+}
+
+// Bytes of the filtered scanlines (filter byte + packed row) the IHDR implies; 0 if invalid.
+inline std::size_t filteredSize(const PngLayout& l) {
+  const std::size_t bits = bitsPerPixel(l);
+  if (bits == 0) return 0;
+  std::size_t total = 0;
+  forEachPass(l, [&](std::size_t w, std::size_t h) {
+    if (w > 0 && h > 0) total += h * (1 + (w * bits + 7) / 8);
+  });
   return total;
+}
+
+// Calls row(offset) with the offset of every scanline's filter byte below `limit` (a header may
+// claim billions of rows; only those inside the buffer matter).
+template <typename RowFn>
+void forEachRow(const PngLayout& l, std::size_t limit, RowFn row) {
+  const std::size_t bits = bitsPerPixel(l);
+  if (bits == 0) return;
+  std::size_t at = 0;
+  forEachPass(l, [&](std::size_t w, std::size_t h) {
+    if (w == 0 || h == 0) return;
+    for (std::size_t y = 0; y < h && at < limit; ++y, at += 1 + (w * bits + 7) / 8) row(at);
+  });
 }
 
 // All IDAT payloads, concatenated and inflated (at most `limit` bytes); false if not a zlib stream.

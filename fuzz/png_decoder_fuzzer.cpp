@@ -11,6 +11,9 @@
 //    the pixels are equal (catches fast-path unfiltering or channel-order mistakes).
 // Images over kMaxDecodedBytes are not decoded: bounding image sizes is a separate task (issue 13).
 #include <cstdint>
+#include <cstdlib>
+#include <map>
+#include <string>
 #include <random>
 #include <vector>
 
@@ -28,8 +31,8 @@ using plumb::fuzz::PngChunk;
 using plumb::fuzz::PngFile;
 using plumb::fuzz::PngLayout;
 
-constexpr std::size_t kMaxDecodedBytes = 16u << 20;
-constexpr std::size_t kMaxInflated = 1u << 20;  // the mutator edits scanlines up to this size
+constexpr std::size_t kMaxDecodedBytes = 2u << 20;  // a 640x480 BGR frame is 0.9 MiB; larger is slow under ASan
+constexpr std::size_t kMaxInflated = 64u << 10;  // the mutator edits scanlines up to this size (keeps it fast)
 
 // libFuzzer's byte mutator on a vector (it may grow the vector up to `max_size`).
 void mutateBytes(std::vector<uint8_t>* bytes, std::size_t max_size) {
@@ -39,14 +42,19 @@ void mutateBytes(std::vector<uint8_t>* bytes, std::size_t max_size) {
   bytes->resize(n);
 }
 
-// Filtered scanlines of the right size for `layout`: random samples, filter bytes mostly valid.
+// Makes every row's filter byte one of the five valid types (one row in 64 left invalid), so
+// mutated scanlines reach the unfiltering code instead of stopping at the first filter byte.
+void repairFilterBytes(const PngLayout& layout, std::vector<uint8_t>* filtered, std::mt19937& rng) {
+  plumb::fuzz::forEachRow(layout, filtered->size(), [&](std::size_t at) {
+    if ((*filtered)[at] > 4 && rng() % 64 != 0) (*filtered)[at] %= 5;
+  });
+}
+
+// Filtered scanlines of the right size for `layout`: random samples and filter bytes.
 std::vector<uint8_t> randomScanlines(const PngLayout& layout, std::mt19937& rng) {
   std::vector<uint8_t> filtered(plumb::fuzz::filteredSize(layout));
   for (uint8_t& b : filtered) b = uint8_t(rng());
-  const std::size_t bits = std::size_t(plumb::fuzz::samplesPerPixel(layout.colour_type)) * layout.bit_depth;
-  const std::size_t row = 1 + (std::size_t(layout.width) * bits + 7) / 8;
-  if (layout.interlace == 0)
-    for (std::size_t at = 0; at < filtered.size(); at += row) filtered[at] = uint8_t(rng() % (rng() % 8 == 0 ? 256 : 5));
+  repairFilterBytes(layout, &filtered, rng);
   return filtered;
 }
 
@@ -97,6 +105,7 @@ void mutatePixels(PngFile* png, std::mt19937& rng) {
   if (filtered.empty() && expected > 0 && expected <= kMaxInflated) filtered = randomScanlines(layout, rng);
   mutateBytes(&filtered, filtered.size() + 16);
   if (rng() % 4 != 0 && expected > 0 && expected <= kMaxInflated) filtered.resize(expected, uint8_t(rng()));
+  if (expected > 0 && rng() % 8 != 0) repairFilterBytes(layout, &filtered, rng);
   plumb::fuzz::replaceIdat(png, filtered, int(rng() % 10), 1 + int(rng() % 4));
 }
 
@@ -190,11 +199,22 @@ namespace {
 // pixels?): headers read, images decoded, of those compared with cv::imdecode.
 struct Reach {
   uint64_t inputs = 0, headers = 0, decoded = 0, compared = 0;
+  const bool enabled = std::getenv("PLUMB_FUZZ_STATS") != nullptr;
+  std::map<std::string, uint64_t> errors;  // decodePixels() failures by message (row numbers cut)
+  void failed(const char* message) {
+    if (!enabled) return;
+    std::string key;  // digits dropped, so "row 3: ... type 9" and "row 4: ... type 7" count together
+    for (const char* c = message; *c != '\0' && key.size() < 60; ++c)
+      if (*c < '0' || *c > '9') key.push_back(*c);
+    ++errors[key];
+  }
   ~Reach() {
-    if (std::getenv("PLUMB_FUZZ_STATS") != nullptr)
-      std::fprintf(stderr, "png reach: %llu inputs, %llu headers, %llu decoded, %llu compared with imdecode\n",
-                   (unsigned long long)inputs, (unsigned long long)headers, (unsigned long long)decoded,
-                   (unsigned long long)compared);
+    if (!enabled) return;
+    std::fprintf(stderr, "png reach: %llu inputs, %llu headers, %llu decoded, %llu compared with imdecode\n",
+                 (unsigned long long)inputs, (unsigned long long)headers, (unsigned long long)decoded,
+                 (unsigned long long)compared);
+    for (const auto& [message, count] : errors)
+      std::fprintf(stderr, "  %8llu  %s\n", (unsigned long long)count, message.c_str());
   }
 } reach;
 
@@ -218,6 +238,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (bytes > kMaxDecodedBytes) return 0;
   if (!decoder.decodePixels(image)) {
     FUZZ_CHECK(decoder.error()[0] != '\0');
+    reach.failed(decoder.error());
     return 0;
   }
   ++reach.decoded;
