@@ -45,8 +45,11 @@ class Parser {
                          std::to_string(column) + ": " + what);
   }
 
+  // RFC 8259 whitespace only (not strchr(" \t\r\n", c): that also matches a NUL byte).
+  static bool isWhitespace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+
   void skipWhitespace() {
-    while (pos_ < text_.size() && std::strchr(" \t\r\n", text_[pos_]) != nullptr) ++pos_;
+    while (pos_ < text_.size() && isWhitespace(text_[pos_])) ++pos_;
   }
 
   bool consume(char c) {
@@ -102,7 +105,10 @@ class Parser {
       return pos_ > from;
     };
     if (text_[pos_] == '-') ++pos_;
+    // int = "0" / nonzero digit *digit: "01" is not JSON.
+    const std::size_t int_start = pos_;
     if (!digits()) return error("malformed number");
+    if (text_[int_start] == '0' && pos_ - int_start > 1) return error("malformed number: leading zero");
     if (pos_ < text_.size() && text_[pos_] == '.') {
       ++pos_;
       if (!digits()) return error("malformed number: digits expected after '.'");
@@ -115,6 +121,13 @@ class Parser {
     out->type = JsonValue::Type::kNumber;
     out->number = std::strtod(text_.substr(start, pos_ - start).c_str(), nullptr);
     return Status::Ok();
+  }
+
+  static int hexDigit(char c) {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return -1;
   }
 
   static void appendUtf8(unsigned code, std::string* out) {
@@ -154,10 +167,13 @@ class Parser {
         case 't': out->push_back('\t'); break;
         case 'u': {
           if (pos_ + 4 > text_.size()) return error("truncated \\u escape");
-          char* end = nullptr;
-          const std::string hex = text_.substr(pos_, 4);
-          const unsigned code = static_cast<unsigned>(std::strtoul(hex.c_str(), &end, 16));
-          if (end != hex.c_str() + 4) return error("malformed \\u escape");
+          // Exactly four hex digits (strtoul would also take a sign, spaces or "0x").
+          unsigned code = 0;
+          for (int k = 0; k < 4; ++k) {
+            const int digit = hexDigit(text_[pos_ + k]);
+            if (digit < 0) return error("malformed \\u escape");
+            code = code * 16 + static_cast<unsigned>(digit);
+          }
           pos_ += 4;
           appendUtf8(code, out);  // surrogate pairs are kept as two code units; names are ASCII
           break;

@@ -10,6 +10,7 @@ PACKAGES=(
   libgtest-dev libbenchmark-dev
   python3-dev python3-pybind11 pybind11-dev python3-numpy python3-pytest
   valgrind
+  clang libclang-rt-14-dev  # fuzz targets (scripts/fuzz.sh): libFuzzer is in libclang-rt-14-dev
 )
 # libjpeg62-turbo-dev: MJPEG cameras and JPEG images in TUM folders (optional at build time).
 # valgrind: ctest instruction_budget (bench/instructions/; skipped without it).

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Quick start 2: install what is missing, build, run every test:
 #   1. the Release build and its whole ctest suite;
-#   2. platform/ and runtime/ tests again under ThreadSanitizer (lock-free code).
+#   2. platform/ and runtime/ tests again under ThreadSanitizer (lock-free code);
+#   3. every parser's libFuzzer target for 20 s each (scripts/fuzz.sh; skipped without clang).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 JOBS=$(nproc 2>/dev/null || echo 2)
@@ -14,3 +15,10 @@ cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPLUMB_TSAN_ONLY=ON 
   -DPLUMB_SANITIZE=thread >/dev/null
 cmake --build build-tsan -j "$JOBS"
 TSAN_OPTIONS="halt_on_error=1" ctest --test-dir build-tsan --output-on-failure -j "$JOBS" --timeout 600
+
+echo "== Fuzzing: every parser, 20 s each (scripts/fuzz.sh) =="
+if command -v clang++ >/dev/null 2>&1; then
+  bash scripts/fuzz.sh 20
+else
+  echo "skipped: clang++ not found (scripts/install_deps.sh installs clang and libclang-rt-14-dev)"
+fi

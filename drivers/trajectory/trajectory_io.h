@@ -48,8 +48,10 @@ Status readTumTrajectory(const std::string& path, std::vector<StampedPose>* out,
 std::string formatTumLine(const StampedPose& pose);
 
 // The same bytes into a caller's buffer (no heap allocation, for the per-frame writer); returns
-// the length, truncating to buffer_size - 1. kTumLineCapacity always fits a whole line.
-constexpr std::size_t kTumLineCapacity = 256;
+// the length, truncating to buffer_size - 1. kTumLineCapacity always fits a whole line: the
+// longest is a %.6f timestamp of -DBL_MAX (317 characters) and seven %.9g numbers of at most 16
+// ("-1.23456789e+308") with their spaces, 436 in all (the reader accepts any finite value).
+constexpr std::size_t kTumLineCapacity = 512;
 std::size_t formatTumLine(const StampedPose& pose, char* buffer, std::size_t buffer_size);
 
 // Writes the header comment and one line per pose.

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include <cmath>
@@ -115,6 +116,37 @@ void expectTrajectoryError(const std::string& content, const std::string& locati
   ASSERT_FALSE(st.ok()) << content;
   EXPECT_NE(st.message().find(path + location), std::string::npos) << st.message();
   EXPECT_NE(st.message().find(words), std::string::npos) << st.message();
+}
+
+// Found by fuzz/trajectory_reader_fuzzer.cpp: the reader accepts any finite timestamp, but the
+// writer's 256-byte line cut a %.6f timestamp above ~1e240 short, so the file it wrote did not
+// read back. Every finite value must now print whole and read back.
+TEST(TrajectoryIo, HugeFiniteValuesWriteWholeLinesThatReadBack) {
+  TempDir dir;
+  StampedPose big = pose(1e300, -1.5e308, 2.5e-308, 1e300, 0.4, {1, 1, 0});
+  StampedPose lost;
+  lost.timestamp = 1.7976931348623157e308;
+  lost.valid = false;
+  lost.dropped = true;
+  const std::string line = formatTumLine(big);
+  EXPECT_GT(line.size(), 300u);
+  EXPECT_LT(line.size(), kTumLineCapacity);
+  EXPECT_EQ(std::count(line.begin(), line.end(), ' '), 7) << line;  // all 8 fields
+  const std::string path = dir.file("huge.txt");
+  ASSERT_TRUE(writeTumTrajectory(path, {big, lost}).ok());
+  std::vector<StampedPose> read;
+  TrajectoryReadOptions options;
+  options.keep_lost_markers = true;
+  const Status status = readTumTrajectory(path, &read, options);
+  ASSERT_TRUE(status.ok()) << status.message();
+  ASSERT_EQ(read.size(), 2u);
+  EXPECT_EQ(read[0].timestamp, 1e300);
+  EXPECT_EQ(read[0].T_world_cam.translation().x(), -1.5e308);  // %.9g: 9 digits exact
+  EXPECT_NEAR(read[0].T_world_cam.translation().y(), 2.5e-308, 1e-316);
+  EXPECT_TRUE(read[0].T_world_cam.linear().isApprox(big.T_world_cam.linear(), 1e-8));
+  EXPECT_FALSE(read[1].valid);
+  EXPECT_TRUE(read[1].dropped);
+  EXPECT_EQ(read[1].timestamp, 1.7976931348623157e308);
 }
 
 TEST(TrajectoryIo, BadLinesNameFileAndLine) {

@@ -39,5 +39,42 @@ TEST(JsonReader, RefusesHostileNesting) {
   EXPECT_FALSE(parseJson(std::string(100000, '['), &v).ok());
 }
 
+// Found by fuzz/json_reader_fuzzer.cpp (differential against the RFC 8259 grammar): a NUL byte was
+// skipped as whitespace, because strchr(" \t\r\n", c) also matches the terminating NUL.
+TEST(JsonReader, RefusesNulBytesOutsideStrings) {
+  JsonValue v;
+  for (const std::string bad : {std::string("[1,\0 2]", 7), std::string("\0{}", 3), std::string("{}\0", 3),
+                                std::string("{\"a\":\0 1}", 9)}) {
+    EXPECT_FALSE(parseJson(bad, &v).ok()) << "accepted a NUL byte at offset " << bad.find('\0');
+  }
+  EXPECT_TRUE(parseJson(" \t\r\n[1, 2]\n", &v).ok());
+}
+
+// Found by the fuzzer: RFC 8259 numbers have no leading zeros ("01" is not JSON).
+TEST(JsonReader, RefusesLeadingZeros) {
+  JsonValue v;
+  for (const char* bad : {"01", "-01", "[00]", "{\"a\": 007.5}", "00e1"}) {
+    EXPECT_FALSE(parseJson(bad, &v).ok()) << "accepted: " << bad;
+  }
+  for (const char* good : {"0", "-0", "0.5", "0e3", "10", "[0, 100]"}) {
+    EXPECT_TRUE(parseJson(good, &v).ok()) << "refused: " << good;
+  }
+  ASSERT_TRUE(parseJson("[-0.25, 0E-2, 120]", &v).ok());
+  EXPECT_EQ(v.items[0].number, -0.25);
+  EXPECT_EQ(v.items[1].number, 0.0);
+  EXPECT_EQ(v.items[2].number, 120.0);
+}
+
+// Found by the fuzzer: \u must be followed by exactly four hex digits; strtoul also took a sign,
+// spaces and a "0x" prefix ("\u-001" even produced the byte 0xFF, which is never UTF-8).
+TEST(JsonReader, UnicodeEscapeNeedsFourHexDigits) {
+  JsonValue v;
+  for (const char* bad : {R"("\u0x12")", R"("\u+123")", R"("\u 123")", R"("\u-001")", R"("\u12g4")", R"("\u12")"}) {
+    EXPECT_FALSE(parseJson(bad, &v).ok()) << "accepted: " << bad;
+  }
+  ASSERT_TRUE(parseJson(R"("\u0041\u00e9\u20AC")", &v).ok());
+  EXPECT_EQ(v.string, "A\xc3\xa9\xe2\x82\xac");
+}
+
 }  // namespace
 }  // namespace plumb::runtime
