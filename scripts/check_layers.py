@@ -106,6 +106,8 @@ def header_family(name):
         return "png"
     if name == "libdeflate.h":
         return "libdeflate"
+    if name == "zlib.h":
+        return "zlib"
     if name == "jpeglib.h":
         return "jpeg"
     if name in ("OpenNI.h", "openni2/OpenNI.h"):
@@ -141,7 +143,7 @@ ALLOWED_FAMILIES = {
     "tests/support": _ALL_THIRD_PARTY + ["gtest"],
     "tests/*": _ALL_THIRD_PARTY + ["gtest", "ceres"],  # Ceres: a test-only oracle
     "bench": _ALL_THIRD_PARTY + ["ceres"],
-    "fuzz": _ALL_THIRD_PARTY,
+    "fuzz": _ALL_THIRD_PARTY + ["zlib"],  # zlib: re-deflating mutated PNGs
 }
 
 # CMake link items that are not targets of the tree, by family.
@@ -151,7 +153,8 @@ LINK_FAMILIES = [
     (r"opencv_.*|\$\{OpenCV_LIBS\}|\$\{OpenCV_LIBRARIES\}", "opencv"),
     (r"Threads::Threads|pthread|rt|dl|\$\{CMAKE_THREAD_LIBS_INIT\}", "posix"),
     (r"m", "std"),
-    (r"PNG::PNG|png", "png"),
+    (r"PNG::PNG|PkgConfig::PNG|png", "png"),
+    (r"ZLIB::ZLIB|PkgConfig::ZLIB|z", "zlib"),
     (r"JPEG::JPEG|jpeg", "jpeg"),
     (r"PkgConfig::LIBDEFLATE|deflate", "libdeflate"),
     (r"PkgConfig::OPENNI2|OpenNI2", "openni2"),
