@@ -4,6 +4,8 @@
 #include <cmath>
 
 #include "drivers/synth/camera_path.h"
+#include "drivers/synth/corridor_layout.h"
+#include "drivers/synth/corridor_path.h"
 #include "drivers/synth/frame_renderer.h"
 #include "drivers/synth/room_layout.h"
 #include "drivers/synth/sensor_model.h"
@@ -46,6 +48,11 @@ const Preset* findPreset(const std::string& name) {
 
 }  // namespace
 
+int presetDefaultFrames(const std::string& preset) {
+  const Preset* p = findPreset(preset);
+  return p ? p->default_frames : 0;
+}
+
 Status validate(const SynthOptions& o) {
   if (!findPreset(o.preset))
     return Status::Error("synth: unknown preset '" + o.preset + "' (use textured, low_texture, fast_rotation, loop or repeated)");
@@ -80,8 +87,10 @@ class SyntheticSceneImpl {
   explicit SyntheticSceneImpl(const SynthOptions& options)
       : options_(options),
         camera_(synthCamera()),
-        model_(synth::buildRoom(layoutOptions(options))),
+        corridor_(findPreset(options.preset)->corridor),
+        model_(corridor_ ? synth::buildCorridor(corridorOptions(options)) : synth::buildRoom(layoutOptions(options))),
         path_(pathOptions(options)),
+        corridor_path_(synth::CorridorPathOptions{options.seed}),
         renderer_(model_, camera_) {
     sensor_.pixel_noise_sigma = options.pixel_noise_sigma;
     sensor_.depth_noise = options.depth_noise;
@@ -96,6 +105,11 @@ class SyntheticSceneImpl {
   static synth::RoomLayoutOptions layoutOptions(const SynthOptions& options) {
     synth::RoomLayoutOptions layout;
     layout.textured = findPreset(options.preset)->textured;
+    layout.seed = options.seed;
+    return layout;
+  }
+  static synth::CorridorLayoutOptions corridorOptions(const SynthOptions& options) {
+    synth::CorridorLayoutOptions layout;
     layout.seed = options.seed;
     return layout;
   }
@@ -114,10 +128,16 @@ class SyntheticSceneImpl {
     return path;
   }
 
+  Eigen::Isometry3d T_world_cam(double t_s) const {
+    return corridor_ ? corridor_path_.T_world_cam(t_s) : path_.T_world_cam(t_s);
+  }
+
   SynthOptions options_;
   PinholeCamera camera_;
+  bool corridor_;
   synth::SceneModel model_;
   synth::CameraPath path_;
+  synth::CorridorPath corridor_path_;
   synth::FrameRenderer renderer_;  // scratch buffers: why render() is not reentrant
   synth::SensorModelOptions sensor_;
   uint64_t noise_seed_ = 0;
@@ -139,7 +159,7 @@ int SyntheticScene::numFrames() const { return impl_->options_.frames; }
 double SyntheticScene::timestamp(int i) const { return kFirstTimestamp + i / impl_->options_.fps; }
 
 Eigen::Isometry3d SyntheticScene::T_world_cam(int i) const {
-  return impl_->path_.T_world_cam(i / impl_->options_.fps);
+  return impl_->T_world_cam(i / impl_->options_.fps);
 }
 
 Status SyntheticScene::render(int i, RgbdImage& out) const {
