@@ -11,17 +11,32 @@
 //             wandering +-0.45 m slowly, plus ~1 Hz hand jitter; roll +-5.5 deg
 //   fast:     rotation_scale > 1 scales the gaze wander, jitter and roll and adds yaw / pitch
 //             swings of +-14*scale / +-4*scale deg at 0.25 / 0.35 Hz (period 20 s)
+//   laps:     laps > 1 goes around `laps` times per period; every term above then repeats each
+//             lap, and `lap_variation` adds terms at the period frequency (half the lap frequency
+//             for 2 laps), so lap 2 passes a few centimetres and degrees beside lap 1 (a revisit,
+//             not a replay) and the whole path still closes exactly after period_s
+//   gaze:     kAcrossRoom (above) or kAtWall: the target lies `wall_gaze_distance_m` outward
+//             from the camera, turned `wall_gaze_lead_rad` towards the direction of travel, so the
+//             camera sweeps the walls at 1-2 m as it circles
 #include <cstdint>
 
 #include <Eigen/Geometry>
 
 namespace plumb::synth {
 
+enum class PathGaze { kAcrossRoom, kAtWall };
+
 struct CameraPathOptions {
   uint64_t seed = 1;            // phases of every sinusoid and the starting angle on the loop
-  double period_s = 20.0;       // one lap
+  double period_s = 20.0;       // the whole path (laps laps); it repeats after that
   double rotation_scale = 1.0;  // 1: hand-held; 2: "fast_rotation"
   Eigen::Vector3d centre_world = Eigen::Vector3d(3.75, 3.0, 0.0);  // floor point the path circles
+  int laps = 1;                 // times around per period
+  double lap_variation_m = 0.0;  // amplitude of the terms that make laps differ (0: identical laps)
+  double radius_x_m = 1.8, radius_y_m = 1.3;  // ellipse radii
+  PathGaze gaze = PathGaze::kAcrossRoom;
+  double wall_gaze_distance_m = 2.0;  // kAtWall: how far out the gaze target lies
+  double wall_gaze_lead_rad = 0.5;    // kAtWall: target turned this far towards the travel direction
 };
 
 class CameraPath {
@@ -41,7 +56,7 @@ class CameraPath {
 
   CameraPathOptions options_;
   double start_angle_ = 0;
-  Wave radius_[2], height_[2], target_x_[2], target_y_[2], target_z_[2], roll_[2], yaw_[1], pitch_[1];
+  Wave radius_[3], height_[3], target_x_[3], target_y_[3], target_z_[2], roll_[2], yaw_[1], pitch_[1];
 };
 
 }  // namespace plumb::synth

@@ -4,6 +4,8 @@
 #include <cmath>
 
 #include "drivers/synth/camera_path.h"
+#include "drivers/synth/corridor_layout.h"
+#include "drivers/synth/corridor_path.h"
 #include "drivers/synth/frame_renderer.h"
 #include "drivers/synth/room_layout.h"
 #include "drivers/synth/sensor_model.h"
@@ -15,15 +17,27 @@ namespace {
 
 constexpr double kFirstTimestamp = 1000.0;
 
+// What a preset changes. The room presets share one layout per seed; "loop" circles nearer the
+// walls, looking at them, twice; "repeated" is a different building (a corridor, layout below).
 struct Preset {
   const char* name;
   bool textured;
   double rotation_scale;
+  int laps = 1;                   // laps of the closed path per period (period = laps x loop_period_s)
+  double lap_variation_m = 0.0;   // how far lap 2 strays from lap 1
+  double radius_x_m = 1.8, radius_y_m = 1.3;
+  synth::PathGaze gaze = synth::PathGaze::kAcrossRoom;
+  double wall_gaze_lead_rad = 0.0;  // kAtWall: gaze turned this far towards the travel direction
+  bool corridor = false;          // the repeated-texture corridor instead of the room
+  int default_frames = 300;       // what `synth:NAME` renders when no frame count is given
 };
 constexpr Preset kPresets[] = {
     {"textured", true, 1.0},
     {"low_texture", false, 1.0},
     {"fast_rotation", true, 2.0},
+    // Tuned so that the noisy odometry drifts 2-3 cm ATE over the two laps (docs/SYNTHETIC.md).
+    {"loop", true, 1.0, 2, 0.05, 2.3, 1.7, synth::PathGaze::kAtWall, 0.2, false, 1200},
+    {"repeated", true, 1.0, 1, 0.0, 0.0, 0.0, synth::PathGaze::kAcrossRoom, 0.0, true, 900},
 };
 
 const Preset* findPreset(const std::string& name) {
@@ -34,9 +48,14 @@ const Preset* findPreset(const std::string& name) {
 
 }  // namespace
 
+int presetDefaultFrames(const std::string& preset) {
+  const Preset* p = findPreset(preset);
+  return p ? p->default_frames : 0;
+}
+
 Status validate(const SynthOptions& o) {
   if (!findPreset(o.preset))
-    return Status::Error("synth: unknown preset '" + o.preset + "' (use textured, low_texture or fast_rotation)");
+    return Status::Error("synth: unknown preset '" + o.preset + "' (use textured, low_texture, fast_rotation, loop or repeated)");
   if (o.frames <= 0) return Status::Error("synth: frames must be positive (got " + std::to_string(o.frames) + ")");
   if (!std::isfinite(o.fps) || o.fps <= 0) return Status::Error("synth: fps must be a positive number");
   if (!std::isfinite(o.loop_period_s) || o.loop_period_s <= 0)
@@ -68,8 +87,10 @@ class SyntheticSceneImpl {
   explicit SyntheticSceneImpl(const SynthOptions& options)
       : options_(options),
         camera_(synthCamera()),
-        model_(synth::buildRoom(layoutOptions(options))),
+        corridor_(findPreset(options.preset)->corridor),
+        model_(corridor_ ? synth::buildCorridor(corridorOptions(options)) : synth::buildRoom(layoutOptions(options))),
         path_(pathOptions(options)),
+        corridor_path_(synth::CorridorPathOptions{options.seed}),
         renderer_(model_, camera_) {
     sensor_.pixel_noise_sigma = options.pixel_noise_sigma;
     sensor_.depth_noise = options.depth_noise;
@@ -87,18 +108,36 @@ class SyntheticSceneImpl {
     layout.seed = options.seed;
     return layout;
   }
+  static synth::CorridorLayoutOptions corridorOptions(const SynthOptions& options) {
+    synth::CorridorLayoutOptions layout;
+    layout.seed = options.seed;
+    return layout;
+  }
   static synth::CameraPathOptions pathOptions(const SynthOptions& options) {
     synth::CameraPathOptions path;
     path.seed = options.seed;
-    path.period_s = options.loop_period_s;
-    path.rotation_scale = findPreset(options.preset)->rotation_scale;
+    const Preset& preset = *findPreset(options.preset);
+    path.period_s = options.loop_period_s * preset.laps;
+    path.rotation_scale = preset.rotation_scale;
+    path.laps = preset.laps;
+    path.lap_variation_m = preset.lap_variation_m;
+    path.radius_x_m = preset.radius_x_m;
+    path.radius_y_m = preset.radius_y_m;
+    path.gaze = preset.gaze;
+    path.wall_gaze_lead_rad = preset.wall_gaze_lead_rad;
     return path;
+  }
+
+  Eigen::Isometry3d T_world_cam(double t_s) const {
+    return corridor_ ? corridor_path_.T_world_cam(t_s) : path_.T_world_cam(t_s);
   }
 
   SynthOptions options_;
   PinholeCamera camera_;
+  bool corridor_;
   synth::SceneModel model_;
   synth::CameraPath path_;
+  synth::CorridorPath corridor_path_;
   synth::FrameRenderer renderer_;  // scratch buffers: why render() is not reentrant
   synth::SensorModelOptions sensor_;
   uint64_t noise_seed_ = 0;
@@ -120,7 +159,7 @@ int SyntheticScene::numFrames() const { return impl_->options_.frames; }
 double SyntheticScene::timestamp(int i) const { return kFirstTimestamp + i / impl_->options_.fps; }
 
 Eigen::Isometry3d SyntheticScene::T_world_cam(int i) const {
-  return impl_->path_.T_world_cam(i / impl_->options_.fps);
+  return impl_->T_world_cam(i / impl_->options_.fps);
 }
 
 Status SyntheticScene::render(int i, RgbdImage& out) const {

@@ -32,8 +32,14 @@ struct SynthOptions {
   //   "textured"      rich procedural texture everywhere (blobs, noise, posters, checkers): many corners
   //   "low_texture"   plain faces in flat, distinct shades: strong straight edges, few corners
   //   "fast_rotation" the textured room with a faster, more rotational hand-held motion (~2.4x
-//                   the peak angular rate; same path)
-// Both appearances of one seed share the geometry and the trajectory.
+  //                   the peak angular rate; same path)
+  //   "loop"          the textured room circled twice near the walls, looking at them: lap 2
+  //                   revisits lap 1's views a few cm and degrees apart; the path closes after
+  //                   2 x loop_period_s (1200 frames at the defaults). For loop closing.
+  //   "repeated"      a 36 m corridor of identical 3 m modules (doors, pictures, textures), walked
+  //                   one way: repeated texture and no real loop. For rejecting false loops.
+  // The room presets of one seed share the geometry; textured/low_texture/fast_rotation share the
+  // trajectory too.
   std::string preset = "textured";
   // Everything random (layout jitter, colours, textures, trajectory phases, noise) derives from it.
   uint64_t seed = 1;
@@ -41,7 +47,8 @@ struct SynthOptions {
   // smoothly (so a 10,000-frame run is many identical laps: no separate `loops` count needed).
   int frames = 300;
   double fps = 30.0;
-  // Duration of one lap of the closed camera path. One lap is ~9 m of travel, so the default
+  // Duration of one lap of the closed camera path ("loop": of each of its two laps; "repeated"
+  // walks at a fixed speed and ignores it). One lap is ~9 m of travel, so the default
   // 300 frames (10 s) cover about half a lap: ~4.5 m at ~0.45 m/s, like a hand-held TUM sequence.
   double loop_period_s = 20.0;
 
@@ -53,6 +60,11 @@ struct SynthOptions {
   double max_depth_m = 8.0;         // farther surfaces read 0 (no reading), like the sensor
   double min_depth_m = 0.3;         // nearer surfaces read 0
 };
+
+// The frame count a preset is meant to be run with: 300 (10 s) for the room presets, 1200 (both
+// laps) for "loop", 900 (30 s, ~13.5 m of corridor) for "repeated"; 0 for an unknown preset.
+// SynthOptions::frames stays 300 unless set: a spec parser that was given no count can use this.
+int presetDefaultFrames(const std::string& preset);
 
 // Empty-OK or a message naming the bad option (unknown preset, frames <= 0, fps <= 0, ...).
 Status validate(const SynthOptions& options);
