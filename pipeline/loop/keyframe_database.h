@@ -33,7 +33,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "pipeline/frame_features.h"
+#include "pipeline/frontend/frame_features.h"
 #include "pipeline/loop/place_words.h"
 #include "platform/fixed_vector.h"
 #include "platform/status.h"

@@ -19,7 +19,7 @@
 #include <array>
 #include <cstdint>
 
-#include "pipeline/frame_features.h"
+#include "pipeline/frontend/frame_features.h"
 
 namespace plumb::loop {
 
