@@ -15,6 +15,8 @@ struct OdometryStats {
   uint64_t relocalizations = 0;
   uint64_t relocalization_attempts = 0;
   uint64_t segments = 0;                // maps started (1 = never restarted)
+  uint64_t loop_corrections_applied = 0;  // loop closing moved the local map
+  uint64_t loop_corrections_stale = 0;    // its keyframe had left the map: not applied
 };
 
 }  // namespace plumb

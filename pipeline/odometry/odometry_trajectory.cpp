@@ -22,6 +22,8 @@ void OdometryTrajectory::push(uint64_t sequence, double timestamp_s, bool valid,
 
 FinishedFrame OdometryTrajectory::resolve(const LocalMap& map, const Pending& p) {
   FinishedFrame out = p.frame;
+  out.reference_id = p.reference_id;
+  out.T_ref_cam = p.T_ref_cam;
   if (p.reference_id == 0) return out;
   for (const LocalMapKeyframe& kf : map.keyframes) {
     if (kf.id == p.reference_id) {

@@ -1,0 +1,87 @@
+#include "pipeline/run/loop_stage.h"
+
+#include "runtime/thread_nice.h"
+
+namespace plumb {
+
+namespace {
+
+loop::LoopCloserOptions withSystemNoise(const loop::LoopCloserOptions& options, const OdometrySystem& system) {
+  loop::LoopCloserOptions o = options;
+  o.verifier.use_lines = o.verifier.use_lines && system.options().odometry.tracker.use_lines;
+  return o;
+}
+
+CameraIntrinsics intrinsicsOf(const PinholeCamera& c) {
+  return CameraIntrinsics{c.fx, c.fy, c.cx, c.cy, c.fx * c.baseline_m};
+}
+
+}  // namespace
+
+LoopStage::LoopStage(OdometrySystem& system, const loop::LoopCloserOptions& options, bool threaded, int thread_nice)
+    : system_(system),
+      closer_(std::make_unique<loop::LoopCloser>(intrinsicsOf(system.camera()),
+                                                 system.options().odometry.extractor.noise,
+                                                 withSystemNoise(options, system))),
+      threaded_(threaded),
+      thread_nice_(thread_nice),
+      made_(std::make_unique<loop::LoopKeyframe>()),
+      popped_(std::make_unique<loop::LoopKeyframe>()),
+      ring_(kRingCapacity) {}
+
+LoopStage::~LoopStage() { finish(); }
+
+void LoopStage::start() {
+  if (threaded_ && !thread_.joinable()) thread_ = std::thread([this] { threadMain(); });
+}
+
+void LoopStage::keyframeInserted(const TrackedFrame& tracked, const FrameOutput& output) {
+  if (!output.keyframe || !output.insert.inserted) return;
+  if (!loop::makeLoopKeyframe(tracked.request, output.insert.keyframe_id, output.new_map, system_.mapper(),
+                              made_.get())) {
+    return;
+  }
+  if (!threaded_) {
+    process(*made_);
+    return;
+  }
+  if (!ring_.try_push(*made_)) {
+    ++dropped_;
+    return;
+  }
+  doorbell_.ring();
+}
+
+void LoopStage::process(const loop::LoopKeyframe& record) {
+  if (!closer_->addKeyframe(record)) return;
+  runtime::LatestSnapshot<MapCorrection>& channel = system_.loopCorrections();
+  channel.writeBuffer() = closer_->correction();
+  channel.publish(++corrections_published_);
+}
+
+void LoopStage::threadMain() {
+  if (thread_nice_ > 0) (void)runtime::setCurrentThreadNice(thread_nice_);
+  for (;;) {
+    bool got = false;
+    doorbell_.waitUntil([&] {
+      got = ring_.try_pop(*popped_);
+      return got || stop_.load(std::memory_order_acquire);
+    });
+    if (got) {
+      process(*popped_);
+      continue;
+    }
+    // Stop requested: finish what the ring still holds.
+    while (ring_.try_pop(*popped_)) process(*popped_);
+    return;
+  }
+}
+
+void LoopStage::finish() {
+  if (!thread_.joinable()) return;
+  stop_.store(true, std::memory_order_release);
+  doorbell_.ring();
+  thread_.join();
+}
+
+}  // namespace plumb
