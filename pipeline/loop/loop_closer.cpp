@@ -94,10 +94,10 @@ bool LoopCloser::pose(uint32_t keyframe_id, Eigen::Isometry3d* T_world_cam) cons
   return true;
 }
 
-Matrix6d LoopCloser::edgeCovariance(const LoopKeyframe& r) const {
-  if (r.new_segment) return diagonalCovariance(options_.segment_translation_sigma_m, options_.segment_rotation_sigma_rad);
-  if (r.covariance_valid && finiteSpd(r.covariance)) {
-    return 0.5 * (r.covariance + r.covariance.transpose()) +
+Matrix6d LoopCloser::edgeCovariance(bool new_segment, const Matrix6d& covariance, bool covariance_valid) const {
+  if (new_segment) return diagonalCovariance(options_.segment_translation_sigma_m, options_.segment_rotation_sigma_rad);
+  if (covariance_valid && finiteSpd(covariance)) {
+    return 0.5 * (covariance + covariance.transpose()) +
            diagonalCovariance(options_.floor_translation_sigma_m, options_.floor_rotation_sigma_rad);
   }
   return diagonalCovariance(options_.default_translation_sigma_m, options_.default_rotation_sigma_rad);
@@ -114,8 +114,9 @@ void LoopCloser::addNode(const LoopKeyframe& r, int slot) {
     const LoopKeyframe& previous_record = records_[std::size_t(order_.back())];
     n.has_edge = true;
     if (!r.new_segment && r.previous_id == previous.id) {
+      n.previous_map_id = r.previous_id;
       n.T_previous_this = r.T_previous_this;
-      n.edge_covariance = edgeCovariance(r);
+      n.edge_covariance = edgeCovariance(r.new_segment, r.covariance, r.covariance_valid);
     } else {
       // A new segment, or the previous keyframe's record never arrived (full ring): the relative
       // pose of the two records as the mapping side had them, with the weak segment covariance.
@@ -229,7 +230,30 @@ bool LoopCloser::plausible(int candidate_position, int query_position, const Loo
   return std::isfinite(chi2) && chi2 <= options_.plausibility_chi2;
 }
 
+void LoopCloser::keyframeFinal(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam, const Matrix6d& covariance,
+                               bool covariance_valid, uint64_t epoch) {
+  const int p = findPosition(keyframe_id);
+  if (p < 0) return;
+  Node& n = nodes_[std::size_t(order_[std::size_t(p)])];
+  n.has_final = true;
+  n.final_epoch = epoch;
+  n.T_world_final = T_world_cam;
+  if (p == 0 || n.previous_map_id == 0) return;
+  const Node& previous = nodes_[std::size_t(order_[std::size_t(p - 1)])];
+  if (previous.id != n.previous_map_id || !previous.has_final || previous.final_epoch != epoch) return;
+  n.T_previous_this = previous.T_world_final.inverse() * T_world_cam;
+  n.edge_length_m = n.T_previous_this.translation().norm();
+  n.edge_covariance = edgeCovariance(false, covariance, covariance_valid);
+  edges_changed_ = true;
+  ++stats_.edges_refined;
+}
+
+void LoopCloser::finalOptimise() {
+  if (edges_changed_ && !order_.empty()) optimise();
+}
+
 void LoopCloser::optimise() {
+  edges_changed_ = false;
   const auto start = std::chrono::steady_clock::now();
   graph_.clear();
   for (std::size_t p = 0; p < order_.size(); ++p) {

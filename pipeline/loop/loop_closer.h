@@ -76,6 +76,7 @@ struct LoopStats {
   uint64_t loops_accepted = 0;
   uint64_t rejected[kNumLoopRejections] = {};  // by LoopRejection (index 0 unused)
   uint64_t culled = 0;
+  uint64_t edges_refined = 0;  // odometry edges replaced by final local-map poses
   uint64_t optimisations = 0;
   double optimisation_ms_total = 0;
   double optimisation_ms_max = 0;
@@ -96,6 +97,17 @@ class LoopCloser {
   bool addKeyframe(const LoopKeyframe& record);
   const MapCorrection& correction() const { return correction_; }
 
+  // A keyframe's FINAL local-map pose and covariance (it left the local map), `epoch` = loop
+  // corrections the mapping side had applied then. When its graph predecessor is the keyframe
+  // before it in the map and got its final pose in the same epoch, the odometry edge between them
+  // is replaced by the relative of the two final poses (BA refined them many times since the
+  // records were made). Takes effect at the next optimisation (finalOptimise() at the end of a run).
+  void keyframeFinal(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam, const Matrix6d& covariance,
+                     bool covariance_valid, uint64_t epoch);
+  // End of a run: optimises once more if edges changed since the last optimisation (without any
+  // loop edge this simply re-chains the refined odometry).
+  void finalOptimise();
+
   // The graph's current pose of a keyframe (optimised after a loop); false if not in the graph.
   bool pose(uint32_t keyframe_id, Eigen::Isometry3d* T_world_cam) const;
   std::size_t size() const { return order_.size(); }
@@ -115,6 +127,10 @@ class LoopCloser {
     Eigen::Isometry3d T_previous_this = Eigen::Isometry3d::Identity();
     Matrix6d edge_covariance = Matrix6d::Identity();  // of this node, previous held fixed
     double edge_length_m = 0;                          // distance travelled along the edge
+    uint32_t previous_map_id = 0;  // the record's previous keyframe in the map (0: none / segment)
+    bool has_final = false;        // keyframeFinal() seen
+    uint64_t final_epoch = 0;
+    Eigen::Isometry3d T_world_final = Eigen::Isometry3d::Identity();
   };
   struct LoopEdge {
     uint32_t candidate_id = 0;
@@ -133,7 +149,7 @@ class LoopCloser {
   void detect(int query_position);
   bool plausible(int candidate_position, int query_position, const LoopMeasurement& m) const;
   void optimise();
-  Matrix6d edgeCovariance(const LoopKeyframe& record) const;
+  Matrix6d edgeCovariance(bool new_segment, const Matrix6d& covariance, bool covariance_valid) const;
 
   LoopCloserOptions options_;
   LoopVerifier verifier_;
@@ -147,6 +163,7 @@ class LoopCloser {
   FixedVector<Group, kMaxPlaceCandidates> groups_, new_groups_;
   PlaceCandidates candidates_;
   int cooldown_ = 0;
+  bool edges_changed_ = false;  // since the last optimisation
   MapCorrection correction_;
   LoopStats stats_;
 };

@@ -27,7 +27,9 @@ LoopStage::LoopStage(OdometrySystem& system, const loop::LoopCloserOptions& opti
       thread_nice_(thread_nice),
       made_(std::make_unique<loop::LoopKeyframe>()),
       popped_(std::make_unique<loop::LoopKeyframe>()),
-      ring_(kRingCapacity) {}
+      ring_(kRingCapacity),
+      final_ring_(kFinalRingCapacity),
+      synchronous_(!threaded) {}
 
 LoopStage::~LoopStage() { finish(); }
 
@@ -41,7 +43,7 @@ void LoopStage::keyframeInserted(const TrackedFrame& tracked, const FrameOutput&
                               made_.get())) {
     return;
   }
-  if (!threaded_) {
+  if (synchronous_) {
     process(*made_);
     return;
   }
@@ -59,29 +61,66 @@ void LoopStage::process(const loop::LoopKeyframe& record) {
   channel.publish(++corrections_published_);
 }
 
+void LoopStage::keyframeRetired(const RetiredKeyframe& kf, uint64_t epoch) {
+  FinalPose f;
+  f.id = kf.id;
+  f.epoch = epoch;
+  f.covariance_valid = kf.covariance_valid;
+  f.T_world_cam = kf.T_world_cam;
+  f.covariance = kf.covariance;
+  if (synchronous_) {
+    processFinal(f);
+    return;
+  }
+  if (!final_ring_.try_push(f)) {
+    ++dropped_;
+    return;
+  }
+  doorbell_.ring();
+}
+
+void LoopStage::processFinal(const FinalPose& f) {
+  closer_->keyframeFinal(f.id, f.T_world_cam, f.covariance, f.covariance_valid, f.epoch);
+}
+
+// Final poses first: they refer to keyframes whose records were pushed earlier (the map stage
+// pushes a keyframe's record at insertion, its final pose ~32 keyframes later), so a final pose
+// never overtakes its record.
+bool LoopStage::popAndProcess() {
+  FinalPose f;
+  if (final_ring_.try_pop(f)) {
+    processFinal(f);
+    return true;
+  }
+  if (ring_.try_pop(*popped_)) {
+    process(*popped_);
+    return true;
+  }
+  return false;
+}
+
 void LoopStage::threadMain() {
   if (thread_nice_ > 0) (void)runtime::setCurrentThreadNice(thread_nice_);
   for (;;) {
-    bool got = false;
-    doorbell_.waitUntil([&] {
-      got = ring_.try_pop(*popped_);
-      return got || stop_.load(std::memory_order_acquire);
-    });
-    if (got) {
-      process(*popped_);
-      continue;
+    doorbell_.waitUntil(
+        [&] { return !final_ring_.empty() || !ring_.empty() || stop_.load(std::memory_order_acquire); });
+    if (popAndProcess()) continue;
+    // Stop requested and nothing left (the producer has finished before stop is set).
+    if (stop_.load(std::memory_order_acquire)) {
+      while (popAndProcess()) {
+      }
+      return;
     }
-    // Stop requested: finish what the ring still holds.
-    while (ring_.try_pop(*popped_)) process(*popped_);
-    return;
   }
 }
 
 void LoopStage::finish() {
-  if (!thread_.joinable()) return;
-  stop_.store(true, std::memory_order_release);
-  doorbell_.ring();
-  thread_.join();
+  if (thread_.joinable()) {
+    stop_.store(true, std::memory_order_release);
+    doorbell_.ring();
+    thread_.join();
+  }
+  synchronous_ = true;
 }
 
 }  // namespace plumb

@@ -40,8 +40,15 @@ class LoopStage {
   void start();  // threaded: starts the thread
   // Map stage thread, for every frame whose output says a keyframe was inserted.
   void keyframeInserted(const TrackedFrame& tracked, const FrameOutput& output);
-  // Processes what the ring still holds and joins the thread.
+  // Map stage thread: a keyframe left the local map with its final pose (OdometrySystem's retired
+  // keyframes); `epoch` = loop corrections applied so far. Through a second small ring (full:
+  // dropped, counted) in the threaded modes. See LoopCloser::keyframeFinal.
+  void keyframeRetired(const RetiredKeyframe& keyframe, uint64_t epoch);
+  // Processes what the rings still hold and joins the thread. After it the stage is synchronous:
+  // keyframeRetired() goes straight to the closer (the end of run's retirements).
   void finish();
+  // After finish() and the last retirements: the final optimisation (LoopCloser::finalOptimise).
+  void finalOptimise() { closer_->finalOptimise(); }
 
   // After finish():
   const loop::LoopStats& stats() const { return closer_->stats(); }
@@ -50,7 +57,17 @@ class LoopStage {
   const loop::LoopCloser& closer() const { return *closer_; }
 
  private:
+  struct FinalPose {
+    uint32_t id = 0;
+    uint64_t epoch = 0;
+    bool covariance_valid = false;
+    Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
+    Matrix6d covariance = Matrix6d::Zero();
+  };
+  static constexpr std::size_t kFinalRingCapacity = 64;
   void process(const loop::LoopKeyframe& record);
+  void processFinal(const FinalPose& f);
+  bool popAndProcess();  // loop thread: one item of either ring; false when both are empty
   void threadMain();
 
   OdometrySystem& system_;
@@ -60,10 +77,12 @@ class LoopStage {
   std::unique_ptr<loop::LoopKeyframe> made_;    // map stage thread
   std::unique_ptr<loop::LoopKeyframe> popped_;  // loop thread
   runtime::SpscRing<loop::LoopKeyframe> ring_;
+  runtime::SpscRing<FinalPose> final_ring_;
+  bool synchronous_;  // deterministic mode, or after finish()
   runtime::Doorbell doorbell_;
   std::atomic<bool> stop_{false};
   std::thread thread_;
-  uint64_t dropped_ = 0;               // map stage thread
+  uint64_t dropped_ = 0;               // map stage thread (records and final poses)
   uint64_t corrections_published_ = 0;  // loop thread
 };
 

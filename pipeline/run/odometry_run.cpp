@@ -74,6 +74,22 @@ Status runOdometry(FrameCapture& capture, OdometrySystem& system, OdometrySink& 
     // The loop stage catches up; its last correction reaches the map before the final poses.
     loop->finish();
     system.applyLoopCorrection();
+  }
+
+  // Whatever ended the run, every pose computed so far (those held back for refinement too) and
+  // every keyframe reach the sink.
+  Status finish_status;
+  system.finish(
+      [&](const FinishedFrame& f) {
+        if (finish_status.ok()) finish_status = sink.onFinishedFrame(f);
+      },
+      [&](const RetiredKeyframe& kf) {
+        if (loop) loop->keyframeRetired(kf, system.stats().loop_corrections_applied);
+        if (finish_status.ok()) finish_status = sink.onRetiredKeyframe(kf);
+      });
+  if (status.ok()) status = finish_status;
+  if (loop) {
+    loop->finalOptimise();
     LoopRunResult& r = result->loop;
     r.enabled = true;
     r.stats = loop->stats();
@@ -89,18 +105,6 @@ Status runOdometry(FrameCapture& capture, OdometrySystem& system, OdometrySink& 
       if (loop->closer().pose(id, &T)) r.keyframes.emplace_back(id, T);
     }
   }
-
-  // Whatever ended the run, every pose computed so far (those held back for refinement too) and
-  // every keyframe reach the sink.
-  Status finish_status;
-  system.finish(
-      [&](const FinishedFrame& f) {
-        if (finish_status.ok()) finish_status = sink.onFinishedFrame(f);
-      },
-      [&](const RetiredKeyframe& kf) {
-        if (finish_status.ok()) finish_status = sink.onRetiredKeyframe(kf);
-      });
-  if (status.ok()) status = finish_status;
 
   result->report = runner.report();
   if (options.keep_trace) result->trace = runner.trace();

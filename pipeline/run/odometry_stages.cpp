@@ -79,6 +79,7 @@ Status MapStage::deliver(const FrameOutput& out) {
     if (status.ok()) status = sink_.onFinishedFrame(f);
   });
   system_.drainRetiredKeyframes([&](const RetiredKeyframe& kf) {
+    if (loop_ != nullptr) loop_->keyframeRetired(kf, system_.stats().loop_corrections_applied);
     if (status.ok()) status = sink_.onRetiredKeyframe(kf);
   });
   return status;

@@ -144,8 +144,8 @@ std::string runSummaryJson(const RunSummary& r) {
     }
     out += "},\n";
     add(std::snprintf(buf, sizeof(buf),
-                      "    \"optimisations\": %" PRIu64 ", \"optimisation_ms_total\": %.3f, \"optimisation_ms_max\": %.3f},\n",
-                      ls.optimisations, ls.optimisation_ms_total, ls.optimisation_ms_max));
+                      "    \"edges_refined\": %" PRIu64 ", \"optimisations\": %" PRIu64 ", \"optimisation_ms_total\": %.3f, \"optimisation_ms_max\": %.3f},\n",
+                      ls.edges_refined, ls.optimisations, ls.optimisation_ms_total, ls.optimisation_ms_max));
   }
   out += "  \"rss_checkpoints\": [";
   const std::vector<RssCheckpoint>& rss = r.statistics->rss();
