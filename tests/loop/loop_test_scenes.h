@@ -1,13 +1,13 @@
 #pragma once
 // Scenes and keyframe records for the loop-closing tests, built on the odometry tests' hand-made
-// FrameFeatures (tests/odometry/synthetic_features.h): no images, exact ground truth.
+// FrameFeatures (tests/support/synthetic_features.h): no images, exact ground truth.
 #include <cmath>
 #include <memory>
 #include <random>
 #include <vector>
 
 #include "pipeline/loop/loop_keyframe.h"
-#include "tests/odometry/synthetic_features.h"
+#include "tests/support/synthetic_features.h"
 
 namespace plumb::test {
 

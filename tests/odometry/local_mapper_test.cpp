@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "pipeline/odometry/local_mapper.h"
-#include "tests/odometry/synthetic_features.h"
+#include "tests/support/synthetic_features.h"
 
 namespace plumb {
 namespace {
