@@ -62,7 +62,9 @@ Status runOdometry(FrameCapture& capture, OdometrySystem& system, OdometrySink& 
   std::unique_ptr<LoopStage> loop;
   if (options.loop_closing) {
     // Off the latency path like the map stage: nice 5 in real-time mode.
-    loop = std::make_unique<LoopStage>(system, options.loop, !lock_step,
+    // Its own thread only where the stages have theirs (not lock-step, not the one-thread
+    // simulation of real time).
+    loop = std::make_unique<LoopStage>(system, options.loop, !lock_step && !simulated,
                                        schedule.mode == runtime::RunMode::kRealtime ? 5 : 0);
     loop->start();
   }
