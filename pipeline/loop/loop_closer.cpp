@@ -1,9 +1,8 @@
 #include "pipeline/loop/loop_closer.h"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
-
-#include <Eigen/Cholesky>
 
 #include "solver/se3.h"
 #include "solver/se3_jacobians.h"
@@ -24,8 +23,8 @@ KeyframeDatabaseOptions databaseOptions(const LoopCloserOptions& o) {
 
 Matrix6d diagonalCovariance(double sigma_t, double sigma_r) {
   Matrix6d c = Matrix6d::Zero();
-  c.diagonal() << sigma_t * sigma_t, sigma_t * sigma_t, sigma_t * sigma_t, sigma_r * sigma_r, sigma_r * sigma_r,
-      sigma_r * sigma_r;
+  c.diagonal() << sigma_t * sigma_t, sigma_t * sigma_t, sigma_t * sigma_t, sigma_r * sigma_r,
+      sigma_r * sigma_r, sigma_r * sigma_r;
   return c;
 }
 
@@ -48,7 +47,8 @@ double poseDistance(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
 
 }  // namespace
 
-LoopCloser::LoopCloser(const CameraIntrinsics& camera, const NoiseModelOptions& noise, const LoopCloserOptions& options)
+LoopCloser::LoopCloser(const CameraIntrinsics& camera, const NoiseModelOptions& noise,
+                       const LoopCloserOptions& options)
     : options_(options),
       verifier_(camera, noise, options.verifier),
       database_(databaseOptions(options)),
@@ -69,8 +69,9 @@ std::size_t LoopCloser::memoryBytesFor(const LoopCloserOptions& o) {
   // the factor (allocated in analyze(), bounded by the structure) are not counted here.
   const std::size_t graph = slots * 300 + (slots + std::size_t(o.max_loop_edges)) * 450;
   return sizeof(LoopCloser) + slots * (sizeof(LoopKeyframe) + sizeof(Node) + 2 * sizeof(int)) +
-         std::size_t(o.max_loop_edges) * sizeof(LoopEdge) + KeyframeDatabase::memoryBytesFor(databaseOptions(o)) +
-         graph + sizeof(LoopVerifier) + 110 * 1024;  // verifier scratch (~105 KB)
+         std::size_t(o.max_loop_edges) * sizeof(LoopEdge) +
+         KeyframeDatabase::memoryBytesFor(databaseOptions(o)) + graph + sizeof(LoopVerifier) +
+         110 * 1024;  // verifier scratch (~105 KB)
 }
 
 std::size_t LoopCloser::memoryBytes() const { return memoryBytesFor(options_); }
@@ -82,7 +83,10 @@ int LoopCloser::findPosition(uint32_t id) const {
     const int mid = (lo + hi) / 2;
     const uint32_t m = nodes_[std::size_t(order_[std::size_t(mid)])].id;
     if (m == id) return mid;
-    if (m < id) lo = mid + 1; else hi = mid - 1;
+    if (m < id)
+      lo = mid + 1;
+    else
+      hi = mid - 1;
   }
   return -1;
 }
@@ -94,8 +98,10 @@ bool LoopCloser::pose(uint32_t keyframe_id, Eigen::Isometry3d* T_world_cam) cons
   return true;
 }
 
-Matrix6d LoopCloser::edgeCovariance(bool new_segment, const Matrix6d& covariance, bool covariance_valid) const {
-  if (new_segment) return diagonalCovariance(options_.segment_translation_sigma_m, options_.segment_rotation_sigma_rad);
+Matrix6d LoopCloser::edgeCovariance(bool new_segment, const Matrix6d& covariance,
+                                    bool covariance_valid) const {
+  if (new_segment)
+    return diagonalCovariance(options_.segment_translation_sigma_m, options_.segment_rotation_sigma_rad);
   if (covariance_valid && finiteSpd(covariance)) {
     return 0.5 * (covariance + covariance.transpose()) +
            diagonalCovariance(options_.floor_translation_sigma_m, options_.floor_rotation_sigma_rad);
@@ -143,8 +149,8 @@ bool LoopCloser::addKeyframe(const LoopKeyframe& record) {
 
   bool accepted = false;
   // Query before inserting: a keyframe never finds itself.
-  const PlaceDescriptors descriptors{r.point_descriptors.data(), r.point_descriptors.size(), r.line_descriptors.data(),
-                                     r.line_descriptors.size()};
+  const PlaceDescriptors descriptors{r.point_descriptors.data(), r.point_descriptors.size(),
+                                     r.line_descriptors.data(), r.line_descriptors.size()};
   if (r.id > uint32_t(options_.min_age_keyframes)) {
     ++stats_.queries;
     PlaceQueryOptions q;
@@ -195,7 +201,8 @@ void LoopCloser::detect(int query_position) {
     ++stats_.verifications;
     const LoopKeyframe& candidate = records_[std::size_t(order_[std::size_t(candidate_position)])];
     LoopMeasurement m = verifier_.verify(query_record, candidate);
-    if (m.accepted() && !plausible(candidate_position, query_position, m)) m.rejection = LoopRejection::kImplausible;
+    if (m.accepted() && !plausible(candidate_position, query_position, m))
+      m.rejection = LoopRejection::kImplausible;
     if (!m.accepted()) {
       ++stats_.rejected[int(m.rejection)];
       continue;
@@ -230,8 +237,8 @@ bool LoopCloser::plausible(int candidate_position, int query_position, const Loo
   return std::isfinite(chi2) && chi2 <= options_.plausibility_chi2;
 }
 
-void LoopCloser::keyframeFinal(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam, const Matrix6d& covariance,
-                               bool covariance_valid, uint64_t epoch) {
+void LoopCloser::keyframeFinal(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam,
+                               const Matrix6d& covariance, bool covariance_valid, uint64_t epoch) {
   const int p = findPosition(keyframe_id);
   if (p < 0) return;
   Node& n = nodes_[std::size_t(order_[std::size_t(p)])];
@@ -278,7 +285,8 @@ void LoopCloser::optimise() {
   const Node& query = nodes_[std::size_t(order_.back())];
   correction_.keyframe_id = query.id;
   correction_.T_world_cam = query.T_world_cam;
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   ++stats_.optimisations;
   stats_.optimisation_ms_total += ms;
   stats_.optimisation_ms_max = std::max(stats_.optimisation_ms_max, ms);
@@ -298,7 +306,8 @@ void LoopCloser::cullOne() {
         if (anchored) continue;
       }
       const Node& previous = nodes_[std::size_t(order_[std::size_t(p - 1)])];
-      const double score = poseDistance(previous.T_world_cam, n.T_world_cam) + poseDistance(n.T_world_cam, next.T_world_cam);
+      const double score =
+          poseDistance(previous.T_world_cam, n.T_world_cam) + poseDistance(n.T_world_cam, next.T_world_cam);
       if (victim < 0 || score < best) {
         victim = p;
         best = score;

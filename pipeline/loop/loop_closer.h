@@ -39,8 +39,8 @@
 namespace plumb::loop {
 
 struct LoopCloserOptions {
-  int capacity = 256;       // keyframe records = database entries = graph nodes
-  int max_loop_edges = 64;  // the oldest loop edge is forgotten when full
+  int capacity = 256;          // keyframe records = database entries = graph nodes
+  int max_loop_edges = 64;     // the oldest loop edge is forgotten when full
   int min_age_keyframes = 40;  // candidate id <= query id - this (the local map holds 32)
   int candidates = 10;         // database results per query
   double min_candidate_score = 0.02;
@@ -69,7 +69,7 @@ struct LoopCloserOptions {
 };
 
 struct LoopStats {
-  uint64_t keyframes = 0;       // records added
+  uint64_t keyframes = 0;  // records added
   uint64_t queries = 0;
   uint64_t consistent_candidates = 0;
   uint64_t verifications = 0;
@@ -80,14 +80,15 @@ struct LoopStats {
   uint64_t optimisations = 0;
   double optimisation_ms_total = 0;
   double optimisation_ms_max = 0;
-  uint64_t loop_edges = 0;  // held now
-  uint64_t graph_nodes = 0;   // held now
+  uint64_t loop_edges = 0;   // held now
+  uint64_t graph_nodes = 0;  // held now
   uint64_t peak_graph_nodes = 0;
 };
 
 class LoopCloser {
  public:
-  LoopCloser(const CameraIntrinsics& camera, const NoiseModelOptions& noise, const LoopCloserOptions& options);
+  LoopCloser(const CameraIntrinsics& camera, const NoiseModelOptions& noise,
+             const LoopCloserOptions& options);
   ~LoopCloser();
   LoopCloser(const LoopCloser&) = delete;
   LoopCloser& operator=(const LoopCloser&) = delete;
@@ -123,10 +124,10 @@ class LoopCloser {
   struct Node {
     uint32_t id = 0;
     Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();  // graph estimate
-    bool has_edge = false;  // from the previous node in order_
+    bool has_edge = false;                                          // from the previous node in order_
     Eigen::Isometry3d T_previous_this = Eigen::Isometry3d::Identity();
     Matrix6d edge_covariance = Matrix6d::Identity();  // of this node, previous held fixed
-    double edge_length_m = 0;                          // distance travelled along the edge
+    double edge_length_m = 0;                         // distance travelled along the edge
     uint32_t previous_map_id = 0;  // the record's previous keyframe in the map (0: none / segment)
     bool has_final = false;        // keyframeFinal() seen
     uint64_t final_epoch = 0;

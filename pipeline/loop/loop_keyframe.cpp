@@ -18,7 +18,9 @@ void fillLoopFeatures(const FrameFeatures& f, LoopKeyframe* out) {
   std::partial_sort(order.begin(), order.begin() + keep, order.begin() + n);
   // Keypoint order inside the record: ascending index (stable, deterministic matching order).
   std::sort(order.begin(), order.begin() + keep,
-            [](const std::pair<float, uint16_t>& a, const std::pair<float, uint16_t>& b) { return a.second < b.second; });
+            [](const std::pair<float, uint16_t>& a, const std::pair<float, uint16_t>& b) {
+              return a.second < b.second;
+            });
   for (std::size_t i = 0; i < keep; ++i) {
     const KeypointObservation& kp = f.keypoints[order[i].second];
     LoopPoint* p = out->points.emplace_back();
@@ -35,7 +37,8 @@ void fillLoopFeatures(const FrameFeatures& f, LoopKeyframe* out) {
     l->l = obs.l.cast<float>();
     l->octave = obs.octave;
     l->num_samples = obs.num_samples;
-    for (int s = 0; s < obs.num_samples; ++s) l->samples_cam[std::size_t(s)] = obs.sample_P_cam[std::size_t(s)];
+    for (int s = 0; s < obs.num_samples; ++s)
+      l->samples_cam[std::size_t(s)] = obs.sample_P_cam[std::size_t(s)];
     (void)out->line_descriptors.push_back(f.line_descriptors[k]);
   }
 }

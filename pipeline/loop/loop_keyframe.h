@@ -13,11 +13,10 @@
 //           mapper's poses right after this keyframe's local BA, and this keyframe's marginal
 //           covariance from that BA (the pose graph's odometry edge and its weight).
 // Size: sizeof(LoopKeyframe), ~43 KB (computed in tests/loop/loop_keyframe_test.cpp).
-#include <array>
-#include <cstdint>
-
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
 
 #include "pipeline/frontend/frame_features.h"
 #include "pipeline/odometry/keyframe_request.h"

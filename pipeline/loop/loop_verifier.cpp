@@ -8,12 +8,18 @@ namespace plumb::loop {
 
 const char* toString(LoopRejection r) {
   switch (r) {
-    case LoopRejection::kNone: return "accepted";
-    case LoopRejection::kFewMatches: return "few_matches";
-    case LoopRejection::kFewInliers: return "few_inliers";
-    case LoopRejection::kLowInlierRatio: return "low_inlier_ratio";
-    case LoopRejection::kRefinement: return "refinement";
-    case LoopRejection::kImplausible: return "implausible_correction";
+    case LoopRejection::kNone:
+      return "accepted";
+    case LoopRejection::kFewMatches:
+      return "few_matches";
+    case LoopRejection::kFewInliers:
+      return "few_inliers";
+    case LoopRejection::kLowInlierRatio:
+      return "low_inlier_ratio";
+    case LoopRejection::kRefinement:
+      return "refinement";
+    case LoopRejection::kImplausible:
+      return "implausible_correction";
   }
   return "?";
 }
@@ -39,7 +45,8 @@ LoopVerifier::~LoopVerifier() = default;
 namespace {
 
 // Index of the best descriptor in [0, n) for d if it passes the threshold and ratio test, else -1.
-int bestMatch(const Descriptor256& d, const Descriptor256* others, std::size_t n, int threshold, float ratio) {
+int bestMatch(const Descriptor256& d, const Descriptor256* others, std::size_t n, int threshold,
+              float ratio) {
   int best = 256, second = 256, best_index = -1;
   for (std::size_t j = 0; j < n; ++j) {
     const int dist = hammingDistance(d, others[j]);
@@ -106,8 +113,9 @@ LoopMeasurement LoopVerifier::verify(const LoopKeyframe& query, const LoopKeyfra
   int num_lines = 0;
   if (options_.use_lines) {
     for (std::size_t k = 0; k < query.lines.size(); ++k) {
-      const int j = bestMatch(query.line_descriptors[k], candidate.line_descriptors.data(),
-                              candidate.line_descriptors.size(), options_.line_hamming_threshold, options_.line_ratio);
+      const int j =
+          bestMatch(query.line_descriptors[k], candidate.line_descriptors.data(),
+                    candidate.line_descriptors.size(), options_.line_hamming_threshold, options_.line_ratio);
       if (j < 0) continue;
       ++m.line_matches;
       const LoopLine& c = candidate.lines[std::size_t(j)];
@@ -121,9 +129,9 @@ LoopMeasurement LoopVerifier::verify(const LoopKeyframe& query, const LoopKeyfra
     }
   }
   PoseOptimizerOptions pose_options;
-  const PoseResult pose = optimizePose(camera_, T_cq.inverse(), s.pose_points.data(), num_points,
-                                       s.pose_lines.data(), num_lines, pose_options, s.pose_point_inlier.data(),
-                                       num_lines > 0 ? s.pose_line_inlier.data() : nullptr);
+  const PoseResult pose = optimizePose(
+      camera_, T_cq.inverse(), s.pose_points.data(), num_points, s.pose_lines.data(), num_lines, pose_options,
+      s.pose_point_inlier.data(), num_lines > 0 ? s.pose_line_inlier.data() : nullptr);
   m.refined_inliers = pose.num_point_inliers;
   m.line_inliers = pose.num_line_inliers;
   if (m.refined_inliers < options_.min_refined_inliers || !pose.covariance_valid) {

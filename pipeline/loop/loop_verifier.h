@@ -12,10 +12,9 @@
 // consistent); the plausibility of the implied correction is judged by the LoopCloser, which knows
 // the odometry covariance between the two keyframes.
 // Scratch allocated at construction; verify() allocates nothing. Deterministic.
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <memory>
-
-#include <Eigen/Geometry>
 
 #include "pipeline/loop/loop_keyframe.h"
 #include "pipeline/loop/rigid_ransac.h"
@@ -26,16 +25,16 @@
 namespace plumb::loop {
 
 struct LoopVerifierOptions {
-  int hamming_threshold = 50;  // ORB match acceptance (of 256 bits)
-  float ratio = 0.8f;          // Lowe ratio: best < ratio * second best
+  int hamming_threshold = 50;       // ORB match acceptance (of 256 bits)
+  float ratio = 0.8f;               // Lowe ratio: best < ratio * second best
   int line_hamming_threshold = 60;  // LBD
   float line_ratio = 0.8f;
   bool use_lines = true;  // line-guidance errors in the refinement
   int min_matches = 40;
   RigidRansacOptions ransac;
-  int min_inliers = 35;          // RANSAC inliers
+  int min_inliers = 35;           // RANSAC inliers
   double min_inlier_ratio = 0.3;  // RANSAC inliers / matches
-  int min_refined_inliers = 35;  // point inliers after refinement
+  int min_refined_inliers = 35;   // point inliers after refinement
 };
 
 enum class LoopRejection : uint8_t {
@@ -66,7 +65,8 @@ struct LoopMeasurement {
 
 class LoopVerifier {
  public:
-  LoopVerifier(const CameraIntrinsics& camera, const NoiseModelOptions& noise, const LoopVerifierOptions& options);
+  LoopVerifier(const CameraIntrinsics& camera, const NoiseModelOptions& noise,
+               const LoopVerifierOptions& options);
   ~LoopVerifier();
   LoopVerifier(const LoopVerifier&) = delete;
   LoopVerifier& operator=(const LoopVerifier&) = delete;

@@ -1,9 +1,8 @@
 #include "pipeline/loop/rigid_ransac.h"
 
+#include <Eigen/SVD>
 #include <algorithm>
 #include <random>
-
-#include <Eigen/SVD>
 
 namespace plumb::loop {
 
@@ -51,8 +50,9 @@ int countInliers(const Eigen::Vector3d* from, const Eigen::Vector3d* to, int n, 
 
 }  // namespace
 
-int rigidRansac(const Eigen::Vector3d* from, const Eigen::Vector3d* to, int n, const RigidRansacOptions& options,
-                bool* scratch, bool* inliers, Eigen::Isometry3d* T_to_from) {
+int rigidRansac(const Eigen::Vector3d* from, const Eigen::Vector3d* to, int n,
+                const RigidRansacOptions& options, bool* scratch, bool* inliers,
+                Eigen::Isometry3d* T_to_from) {
   if (n < 3) return 0;
   std::mt19937 rng(options.seed);
   std::uniform_int_distribution<int> pick(0, n - 1);

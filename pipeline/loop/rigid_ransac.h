@@ -4,10 +4,9 @@
 // is seeded from the options on every call. The relocalizer (pipeline/odometry/relocalizer.cpp)
 // keeps its own copy of the same scheme; its refit uses Eigen::umeyama on dynamic matrices, and
 // sharing this one would change its numerics (and so every trajectory that relocalizes).
-#include <cstdint>
-
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cstdint>
 
 namespace plumb::loop {
 
@@ -25,7 +24,8 @@ bool rigidFitKabsch(const Eigen::Vector3d* from, const Eigen::Vector3d* to, cons
 
 // Best T_to_from over random 3-point fits, refitted on its inliers; `inliers` (n entries) flags
 // them. Returns the inlier count (0 on failure). `scratch` must hold n entries.
-int rigidRansac(const Eigen::Vector3d* from, const Eigen::Vector3d* to, int n, const RigidRansacOptions& options,
-                bool* scratch, bool* inliers, Eigen::Isometry3d* T_to_from);
+int rigidRansac(const Eigen::Vector3d* from, const Eigen::Vector3d* to, int n,
+                const RigidRansacOptions& options, bool* scratch, bool* inliers,
+                Eigen::Isometry3d* T_to_from);
 
 }  // namespace plumb::loop

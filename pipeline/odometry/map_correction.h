@@ -5,9 +5,8 @@
 // (LocalMapper::applyCorrection), so the local map stays internally exactly as consistent as it was
 // and lands where the pose graph put the keyframe. A plain value, sent through a
 // runtime::LatestSnapshot (the newest correction wins; versions count corrections).
-#include <cstdint>
-
 #include <Eigen/Geometry>
+#include <cstdint>
 
 namespace plumb {
 

@@ -6,7 +6,8 @@ namespace plumb {
 
 namespace {
 
-loop::LoopCloserOptions withSystemNoise(const loop::LoopCloserOptions& options, const OdometrySystem& system) {
+loop::LoopCloserOptions withSystemNoise(const loop::LoopCloserOptions& options,
+                                        const OdometrySystem& system) {
   loop::LoopCloserOptions o = options;
   o.verifier.use_lines = o.verifier.use_lines && system.options().odometry.tracker.use_lines;
   return o;
@@ -18,7 +19,8 @@ CameraIntrinsics intrinsicsOf(const PinholeCamera& c) {
 
 }  // namespace
 
-LoopStage::LoopStage(OdometrySystem& system, const loop::LoopCloserOptions& options, bool threaded, int thread_nice)
+LoopStage::LoopStage(OdometrySystem& system, const loop::LoopCloserOptions& options, bool threaded,
+                     int thread_nice)
     : system_(system),
       closer_(std::make_unique<loop::LoopCloser>(intrinsicsOf(system.camera()),
                                                  system.options().odometry.extractor.noise,

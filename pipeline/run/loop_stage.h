@@ -82,7 +82,7 @@ class LoopStage {
   runtime::Doorbell doorbell_;
   std::atomic<bool> stop_{false};
   std::thread thread_;
-  uint64_t dropped_ = 0;               // map stage thread (records and final poses)
+  uint64_t dropped_ = 0;                // map stage thread (records and final poses)
   uint64_t corrections_published_ = 0;  // loop thread
 };
 

@@ -1,9 +1,10 @@
 // LoopCloser on chains of hand-made keyframe records: a drifted loop is closed and corrected, a
 // corridor of repeated modules yields no loop, capacity and culling keep everything bounded, and
 // adding keyframes allocates nothing.
+#include "pipeline/loop/loop_closer.h"
+
 #include <gtest/gtest.h>
 
-#include "pipeline/loop/loop_closer.h"
 #include "platform/allocation_counter.h"
 #include "solver/se3.h"
 #include "tests/loop/loop_test_scenes.h"
@@ -36,7 +37,8 @@ TEST(LoopCloser, ClosesADriftedLoopAndCorrectsTheGraph) {
       step = driftedStep(pose_at(k - 1).inverse() * pose_at(k));
       T_odometry = T_odometry * step;
     }
-    const auto record = recordOf(scene, uint32_t(k + 1), pose_at(k), T_odometry, k > 0 ? uint32_t(k) : 0, step);
+    const auto record =
+        recordOf(scene, uint32_t(k + 1), pose_at(k), T_odometry, k > 0 ? uint32_t(k) : 0, step);
     if (closer.addKeyframe(*record) && accepted_at < 0) {
       accepted_at = k;
       EXPECT_EQ(closer.correction().keyframe_id, uint32_t(k + 1));
@@ -62,8 +64,9 @@ TEST(LoopCloser, ClosesADriftedLoopAndCorrectsTheGraph) {
   }
   odometry_error /= kTotal;
   graph_error /= kTotal;
-  std::printf("keyframe position error, mean / last: odometry %.4f / %.4f m, after loop closing %.4f / %.4f m\n",
-              odometry_error, odometry_last, graph_error, graph_last);
+  std::printf(
+      "keyframe position error, mean / last: odometry %.4f / %.4f m, after loop closing %.4f / %.4f m\n",
+      odometry_error, odometry_last, graph_error, graph_last);
   EXPECT_GT(odometry_error, 0.05);
   // The bias of every step stays in the odometry edges (the graph spreads, not removes, it): the
   // mean halves, the end of the chain (pulled onto lap 1) improves most.
@@ -103,11 +106,14 @@ TEST(LoopCloser, RejectsRepeatedTextureWithoutARealLoop) {
     return T;
   };
   loop::LoopCloser closer = makeCloser(loop::LoopCloserOptions{});
-  loop::LoopVerifier verifier(intrinsicsOf(syntheticCamera()), NoiseModelOptions{}, loop::LoopVerifierOptions{});
+  loop::LoopVerifier verifier(intrinsicsOf(syntheticCamera()), NoiseModelOptions{},
+                              loop::LoopVerifierOptions{});
   const int kTotal = 200;  // 15 m: five modules
   for (int k = 0; k < kTotal; ++k) {
-    const Eigen::Isometry3d step = k > 0 ? pose_at(k - 1).inverse() * pose_at(k) : Eigen::Isometry3d::Identity();
-    const auto record = recordOf(corridor, uint32_t(k + 1), pose_at(k), pose_at(k), k > 0 ? uint32_t(k) : 0, step);
+    const Eigen::Isometry3d step =
+        k > 0 ? pose_at(k - 1).inverse() * pose_at(k) : Eigen::Isometry3d::Identity();
+    const auto record =
+        recordOf(corridor, uint32_t(k + 1), pose_at(k), pose_at(k), k > 0 ? uint32_t(k) : 0, step);
     EXPECT_FALSE(closer.addKeyframe(*record)) << "false loop at keyframe " << k;
   }
   EXPECT_EQ(closer.stats().loops_accepted, 0u);

@@ -40,9 +40,11 @@ inline Eigen::Isometry3d outwardPose(double a, double r) {
 }
 
 // A record of `scene` seen from T_world_cam (true pose), with the given odometry fields.
-inline std::unique_ptr<loop::LoopKeyframe> recordOf(const Scene& scene, uint32_t id, const Eigen::Isometry3d& T_true,
+inline std::unique_ptr<loop::LoopKeyframe> recordOf(const Scene& scene, uint32_t id,
+                                                    const Eigen::Isometry3d& T_true,
                                                     const Eigen::Isometry3d& T_world_cam_odometry,
-                                                    uint32_t previous_id, const Eigen::Isometry3d& T_previous_this) {
+                                                    uint32_t previous_id,
+                                                    const Eigen::Isometry3d& T_previous_this) {
   auto r = std::make_unique<loop::LoopKeyframe>();
   const View view = observe(scene, T_true);
   loop::fillLoopFeatures(*view.features, r.get());

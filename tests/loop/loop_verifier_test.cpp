@@ -1,14 +1,16 @@
 // LoopVerifier on records built from hand-made views of a known scene.
+#include "pipeline/loop/loop_verifier.h"
+
 #include <gtest/gtest.h>
 
-#include "pipeline/loop/loop_verifier.h"
 #include "tests/loop/loop_test_scenes.h"
 
 namespace plumb::test {
 namespace {
 
 loop::LoopVerifier makeVerifier() {
-  return loop::LoopVerifier(intrinsicsOf(syntheticCamera()), NoiseModelOptions{}, loop::LoopVerifierOptions{});
+  return loop::LoopVerifier(intrinsicsOf(syntheticCamera()), NoiseModelOptions{},
+                            loop::LoopVerifierOptions{});
 }
 
 TEST(LoopKeyframe, RecordKeepsStrongestPointsWithDepthAndLinesWith3d) {
@@ -27,7 +29,8 @@ TEST(LoopKeyframe, RecordKeepsStrongestPointsWithDepthAndLinesWith3d) {
   for (const auto& p : r.points) {
     EXPECT_GT(p.P_cam.z(), 0.f);
     for (std::size_t k = 0; k < view.features->keypoints.size(); ++k) {
-      if (view.features->keypoints[k].P_cam == p.P_cam) weakest_kept = std::min(weakest_kept, view.features->keypoints[k].response);
+      if (view.features->keypoints[k].P_cam == p.P_cam)
+        weakest_kept = std::min(weakest_kept, view.features->keypoints[k].response);
     }
   }
   int stronger_left_out = 0;
