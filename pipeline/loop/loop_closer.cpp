@@ -55,6 +55,9 @@ LoopCloser::LoopCloser(const CameraIntrinsics& camera, const NoiseModelOptions& 
       graph_(options.capacity + 1, options.capacity + 1 + options.max_loop_edges),
       records_(new LoopKeyframe[std::size_t(options.capacity + 1)]),
       nodes_(std::size_t(options.capacity + 1)) {
+  // Odometry chain + loop edges: natural order, factor storage reserved here (no allocation by
+  // operator new in later analyses).
+  graph_.reserveChainWithExtraEdges(options.max_loop_edges);
   free_slots_.reserve(std::size_t(options.capacity + 1));
   for (int s = options.capacity; s >= 0; --s) free_slots_.push_back(s);
   order_.reserve(std::size_t(options.capacity + 1));
