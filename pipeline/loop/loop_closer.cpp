@@ -71,9 +71,13 @@ std::size_t LoopCloser::memoryBytesFor(const LoopCloserOptions& o) {
   // Pose graph: nodes (~2 isometries), edges (isometry + 6x6 + kernel), blocks; H's pattern and
   // the factor (allocated in analyze(), bounded by the structure) are not counted here.
   const std::size_t graph = slots * 300 + (slots + std::size_t(o.max_loop_edges)) * 450;
+  // reserveChainWithExtraEdges(): H and the factor's value + index arrays (12 bytes an entry).
+  const std::size_t edges = slots + 1 + std::size_t(o.max_loop_edges);
+  const std::size_t sparse =
+      12 * (21 * slots + 36 * edges + slots * (15 + 36 * (1 + std::size_t(o.max_loop_edges))));
   return sizeof(LoopCloser) + slots * (sizeof(LoopKeyframe) + sizeof(Node) + 2 * sizeof(int)) +
          std::size_t(o.max_loop_edges) * sizeof(LoopEdge) +
-         KeyframeDatabase::memoryBytesFor(databaseOptions(o)) + graph + sizeof(LoopVerifier) +
+         KeyframeDatabase::memoryBytesFor(databaseOptions(o)) + graph + sparse + sizeof(LoopVerifier) +
          110 * 1024;  // verifier scratch (~105 KB)
 }
 
