@@ -64,6 +64,17 @@ PoseGraph::PoseGraph(int max_nodes, int max_edges)
   variable_node_.resize(max_nodes_);
 }
 
+void PoseGraph::reserveChainWithExtraEdges(int max_extra_edges) {
+  natural_order_ = true;
+  const Eigen::Index dim = 6 * Eigen::Index(max_nodes_);
+  const Eigen::Index blocks_per_column = 1 + std::max(0, max_extra_edges);
+  // H: 21 entries per diagonal block, 36 per off-diagonal block (one per edge at most).
+  H_.resize(dim, dim);
+  H_.resizeNonZeros(21 * Eigen::Index(max_nodes_) + 36 * Eigen::Index(max_edges_));
+  // L (strictly lower, column-wise): 15 within each diagonal block and 36 per fill block.
+  factorization_.reserveFactor(dim, Eigen::Index(max_nodes_) * (15 + 36 * blocks_per_column));
+}
+
 void PoseGraph::clear() {
   num_nodes_ = 0;
   num_edges_ = 0;

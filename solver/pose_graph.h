@@ -113,6 +113,16 @@ class PoseGraph {
   PoseGraph(const PoseGraph&) = delete;
   PoseGraph& operator=(const PoseGraph&) = delete;
 
+  // Opt-in for graphs that are a chain in node order plus a bounded number of extra ("loop")
+  // edges, e.g. keyframes linked by odometry and loop edges (pipeline/loop/loop_closer.h):
+  // analyze() then keeps the nodes in their natural order (no AMD: for a chain with E extra
+  // edges the factor has at most 1 + E off-diagonal blocks per block column, so the natural order
+  // fills little) and H and the factor get storage for that bound here, once, so a later analyze()
+  // makes no operator-new allocation (Eigen's sparse arrays are new[]; the outer index arrays
+  // and small dense vectors it still sizes use malloc). A graph beyond the bound still works
+  // (Eigen reallocates).
+  void reserveChainWithExtraEdges(int max_extra_edges);
+
   int maxNodes() const { return max_nodes_; }
   int maxEdges() const { return max_edges_; }
   // Forget nodes and edges; keeps the reserved memory.
@@ -177,7 +187,18 @@ class PoseGraph {
       : public Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Upper, Eigen::NaturalOrdering<int>> {
    public:
     void reserveDiagonal(Eigen::Index size) { m_diag.resize(size); }
+    void reserveFactor(Eigen::Index size, Eigen::Index nnz) {
+      m_matrix.resize(size, size);
+      m_matrix.resizeNonZeros(nnz);
+    }
     void factorizeOrdered(const Eigen::SparseMatrix<double>& H_upper) { factorize_preordered<true>(H_upper); }
+    // analyzePattern() without its copy of the input into a temporary (new[] every call): the
+    // same symbolic analysis (natural ordering, upper triangle) straight on H.
+    void analyzeOrdered(const Eigen::SparseMatrix<double>& H_upper) {
+      m_Pinv.resize(0);
+      m_P.resize(0);
+      analyzePattern_preordered(H_upper, true);
+    }
     const Eigen::VectorXd& diagonalD() const { return m_diag; }
   };
 
@@ -194,6 +215,7 @@ class PoseGraph {
   int num_edges_ = 0;
   int num_variables_ = 0;  // free nodes in the analysed structure
   bool structure_valid_ = false;
+  bool natural_order_ = false;  // reserveChainWithExtraEdges()
 
   std::vector<Node> nodes_;
   std::vector<Edge> edges_;

@@ -26,7 +26,12 @@ bool PoseGraph::analyze() {
 
   // Fill-reducing order of the nodes: AMD on the node adjacency. Ordering 6x6 blocks rather than
   // scalars keeps each block's rows contiguous in the pattern, so values are written by offset.
-  {
+  // reserveChainWithExtraEdges(): the natural order (positions as numbered above).
+  if (natural_order_) {
+    for (int n = 0; n < num_nodes_; ++n) {
+      if (nodes_[n].position >= 0) variable_node_[nodes_[n].position] = n;
+    }
+  } else {
     std::vector<Eigen::Triplet<double>> entries;
     entries.reserve(static_cast<size_t>(num_free) + 2 * static_cast<size_t>(num_edges_));
     for (int v = 0; v < num_free; ++v) entries.emplace_back(v, v, 1.0);
@@ -109,7 +114,7 @@ bool PoseGraph::analyze() {
                          block_keys_.begin());
   }
 
-  factorization_.analyzePattern(H_);
+  factorization_.analyzeOrdered(H_);
   factorization_.reserveDiagonal(dim);
   g_.resize(dim);
   diagonal_.resize(dim);

@@ -36,6 +36,9 @@ void printRunUsage() {
       "  --discard-trajectory run without writing the trajectory (statistics or ATE only)\n"
       "  --line-samples N     line-guidance points per line: 0 (points only) or 2..10 (default 5)\n"
       "  --no-lines           points only (lines are neither mapped nor used for tracking)\n"
+      "  --out-optimized FILE the optimised trajectory (TUM): every frame through its reference\n"
+      "                       keyframe's pose in the final loop-closing pose graph (docs/LOOP.md)\n"
+      "  --no-loops           no loop closing (--out-optimized then equals --out)\n"
       "  --covariance FILE    per keyframe: timestamp and the 21 upper-triangle entries of its 6x6\n"
       "                       pose covariance from local BA (docs/ODOMETRY.md)\n"
       "  --stats FILE         statistics as JSON (states, keyframes, map, ms per frame, RSS, options)\n"
@@ -83,9 +86,10 @@ void onStopSignal(int signal) {
 int runRun(int argc, char** argv) {
   Args args(argc, argv,
             withScheduleFlags({"dataset", "camera", "out", "line-samples", "covariance", "stats", "max-frames",
-                               "gt", "output-delay", "rss-every", "mavlink", "report-every"},
+                               "gt", "output-delay", "rss-every", "mavlink", "report-every", "out-optimized"},
                               scheduleValueFlags()),
-            withScheduleFlags({"no-lines", "synth-noise", "progress", "trace", "count-allocations", "discard-trajectory"},
+            withScheduleFlags({"no-lines", "synth-noise", "progress", "trace", "count-allocations", "discard-trajectory",
+                               "no-loops"},
                               scheduleSwitchFlags()));
   if (args.help()) {
     printRunUsage();
@@ -124,6 +128,7 @@ int runRun(int argc, char** argv) {
   st = parseScheduleFlags(args, &run_options, &profile_path);
   if (!st.ok()) return fail(st.message(), kExitUsage);
   run_options.max_frames = max_frames;
+  run_options.loop_closing = !args.has("no-loops");
   run_options.keep_trace = !profile_path.empty();
   run_options.stop = &g_stop_requested;
   st = validate(run_options);
@@ -136,6 +141,7 @@ int runRun(int argc, char** argv) {
   io.addInput(args.get("camera"));
   io.addOutput("--out", args.get("out"));
   io.addOutput("--covariance", args.get("covariance"));
+  io.addOutput("--out-optimized", args.get("out-optimized"));
   io.addOutput("--stats", args.get("stats"));
   io.addOutput("--profile", profile_path);
   st = io.check();
@@ -159,6 +165,7 @@ int runRun(int argc, char** argv) {
   RunOutputOptions output_options;
   output_options.trajectory_path = args.get("out");
   output_options.covariance_path = args.get("covariance");
+  output_options.optimized_path = args.get("out-optimized");
   output_options.rss_every = rss_every;
   output_options.report_every = report_every;
   output_options.progress = args.has("progress");
@@ -204,6 +211,7 @@ int runRun(int argc, char** argv) {
   } else if (scene != nullptr) {
     ground_truth = syntheticGroundTruth(*scene, long(statistics.frames() + statistics.framesDropped()));
   }
+  double ate_optimized = -1;
   if (!ground_truth.empty() && output_options.keep_trajectory) {
     AteResult result;
     st = evaluateAte(ground_truth, outputs.trajectory(), AteOptions{}, &result);
@@ -211,6 +219,10 @@ int runRun(int argc, char** argv) {
       ate = result.translation_m.rmse;
     } else {
       std::fprintf(stderr, "plumb run: no ATE: %s\n", st.message().c_str());
+    }
+    if (!outputs.optimizedTrajectory().empty() &&
+        evaluateAte(ground_truth, outputs.optimizedTrajectory(), AteOptions{}, &result).ok()) {
+      ate_optimized = result.translation_m.rmse;
     }
   }
 
@@ -248,7 +260,19 @@ int runRun(int argc, char** argv) {
                 (unsigned long long)m.heartbeats_sent, (unsigned long long)m.dropped,
                 (unsigned long long)m.skipped_no_pose, (unsigned long long)m.resets);
   }
+  const LoopRunResult& loop = record.run.loop;
+  if (loop.enabled) {
+    const loop::LoopStats& ls = loop.stats;
+    uint64_t rejected = 0;
+    for (int i = 1; i < loop::kNumLoopRejections; ++i) rejected += ls.rejected[i];
+    std::printf("loop closing: graph %llu keyframes (capacity %zu), loops found %llu, rejected %llu "
+                "(implausible %llu), optimisation %.1f ms total, records dropped %llu\n",
+                (unsigned long long)ls.graph_nodes, loop.capacity, (unsigned long long)ls.loops_accepted,
+                (unsigned long long)rejected, (unsigned long long)ls.rejected[int(loop::LoopRejection::kImplausible)],
+                ls.optimisation_ms_total, (unsigned long long)loop.records_dropped);
+  }
   if (ate >= 0) std::printf("ATE RMSE %.4f m\n", ate);
+  if (ate_optimized >= 0) std::printf("ATE RMSE optimized %.4f m\n", ate_optimized);
   if (!profile_path.empty()) {
     st = writeFileAtomically(profile_path, runtime::formatChromeTrace(record.run.trace, report));
     if (!st.ok()) return fail(st.message());

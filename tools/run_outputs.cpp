@@ -16,7 +16,42 @@ RunOutputs::RunOutputs(const RunOutputOptions& options) : options_(options), sta
   if (options_.keep_trajectory) trajectory_.reserve(options_.expected_frames);
 }
 
+namespace {
+
+// What --out-optimized needs of a finished frame, streamed to the temporary file.
+struct StreamedFrame {
+  double timestamp = 0;
+  uint8_t valid = 0, dropped = 0;
+  uint32_t reference_id = 0;
+  double T_ref_cam[12] = {};    // 3x4, row major
+  double T_world_cam[12] = {};  // real-time pose (fallback)
+};
+
+void toRows(const Eigen::Isometry3d& T, double* out) {
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) out[r * 4 + c] = T.matrix()(r, c);
+  }
+}
+
+Eigen::Isometry3d fromRows(const double* in) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) T.matrix()(r, c) = in[r * 4 + c];
+  }
+  return T;
+}
+
+}  // namespace
+
+RunOutputs::~RunOutputs() {
+  if (frames_stream_ != nullptr) std::fclose(frames_stream_);
+}
+
 Status RunOutputs::open() {
+  if (!options_.optimized_path.empty()) {
+    frames_stream_ = std::tmpfile();
+    if (frames_stream_ == nullptr) return Status::Error("--out-optimized: cannot create a temporary file");
+  }
   if (!options_.trajectory_path.empty()) PLUMB_RETURN_IF_ERROR(trajectory_writer_.open(options_.trajectory_path));
   if (!options_.covariance_path.empty()) PLUMB_RETURN_IF_ERROR(covariance_writer_.open(options_.covariance_path));
   if (!options_.mavlink.endpoint.empty()) {
@@ -96,8 +131,49 @@ Status RunOutputs::onFinishedFrame(const FinishedFrame& f) {
   pose.valid = f.valid;
   pose.dropped = f.dropped;
   if (options_.keep_trajectory) trajectory_.push_back(pose);
+  if (frames_stream_ != nullptr) {
+    StreamedFrame r;
+    r.timestamp = f.timestamp_s;
+    r.valid = f.valid;
+    r.dropped = f.dropped;
+    r.reference_id = f.reference_id;
+    toRows(f.T_ref_cam, r.T_ref_cam);
+    toRows(f.T_world_cam, r.T_world_cam);
+    if (std::fwrite(&r, sizeof(r), 1, frames_stream_) != 1) return Status::Error("--out-optimized: temporary file write failed");
+  }
   if (!options_.trajectory_path.empty()) return trajectory_writer_.append(pose);
   return Status::Ok();
+}
+
+Status RunOutputs::writeOptimized(const LoopRunResult& loop) {
+  if (frames_stream_ == nullptr) return Status::Ok();
+  if (std::fflush(frames_stream_) != 0 || std::fseek(frames_stream_, 0, SEEK_SET) != 0) {
+    return Status::Error("--out-optimized: temporary file unreadable");
+  }
+  TumTrajectoryWriter writer;
+  PLUMB_RETURN_IF_ERROR(writer.open(options_.optimized_path));
+  if (options_.keep_trajectory) optimized_.reserve(trajectory_.size());
+  StreamedFrame r;
+  while (std::fread(&r, sizeof(r), 1, frames_stream_) == 1) {
+    StampedPose pose;
+    pose.timestamp = r.timestamp;
+    pose.valid = r.valid != 0;
+    pose.dropped = r.dropped != 0;
+    pose.T_world_cam = fromRows(r.T_world_cam);
+    Eigen::Isometry3d T_world_ref;
+    if (pose.valid) {
+      if (r.reference_id != 0 && loop.keyframePose(r.reference_id, &T_world_ref)) {
+        pose.T_world_cam = T_world_ref * fromRows(r.T_ref_cam);
+      } else {
+        ++optimized_without_keyframe_;
+      }
+    }
+    if (options_.keep_trajectory) optimized_.push_back(pose);
+    PLUMB_RETURN_IF_ERROR(writer.append(pose));
+  }
+  std::fclose(frames_stream_);
+  frames_stream_ = nullptr;
+  return writer.close();
 }
 
 Status RunOutputs::onRetiredKeyframe(const RetiredKeyframe& kf) {
@@ -119,6 +195,8 @@ Status runToOutputs(FrameSource& source, const SystemOptions& system_options, co
   Status status = runOdometry(capture, *system, outputs, run_options, &record->run);
   const Status closed = outputs.close();
   if (status.ok()) status = closed;
+  const Status optimized = outputs.writeOptimized(record->run.loop);
+  if (status.ok()) status = optimized;
   record->odometry = system->stats();
   record->mapper = system->mapperStats();
   record->mapper_waits = system->mapperWaits();

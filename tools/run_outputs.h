@@ -20,6 +20,9 @@ namespace plumb::tools {
 struct RunOutputOptions {
   std::string trajectory_path;  // TUM file, one line per input frame ('' = none)
   std::string covariance_path;  // one line per keyframe ('' = none)
+  // The optimised trajectory (docs/LOOP.md): every frame through its reference keyframe's pose in
+  // the final pose graph, written at the end of the run ('' = none).
+  std::string optimized_path;
   bool keep_trajectory = true;  // poses in memory (for the ATE); off for very long runs
   std::size_t expected_frames = 0;  // reserve for the kept poses (0: unknown, the vector grows)
   long rss_every = 0;           // > 0: an RSS checkpoint every this many frames
@@ -35,6 +38,7 @@ struct RunOutputOptions {
 class RunOutputs final : public OdometrySink {
  public:
   explicit RunOutputs(const RunOutputOptions& options);
+  ~RunOutputs() override;
   Status open();   // the files
   Status close();  // flushes and closes them
 
@@ -42,6 +46,13 @@ class RunOutputs final : public OdometrySink {
   Status onFrame(const FrameOutput& frame) override;
   Status onFinishedFrame(const FinishedFrame& frame) override;
   Status onRetiredKeyframe(const RetiredKeyframe& keyframe) override;
+
+  // End of run: writes --out-optimized from the frames streamed during the run and the final graph
+  // (keeps those poses for the ATE when keep_trajectory). Frames whose reference keyframe is not in
+  // the graph (no loop closing, culled, never received) keep their real-time pose (counted).
+  Status writeOptimized(const LoopRunResult& loop);
+  const std::vector<StampedPose>& optimizedTrajectory() const { return optimized_; }
+  uint64_t optimizedWithoutKeyframe() const { return optimized_without_keyframe_; }
 
   const std::vector<StampedPose>& trajectory() const { return trajectory_; }
   const RunStatistics& statistics() const { return statistics_; }
@@ -54,6 +65,11 @@ class RunOutputs final : public OdometrySink {
   TumTrajectoryWriter trajectory_writer_;
   CovarianceWriter covariance_writer_;
   std::vector<StampedPose> trajectory_;
+  // --out-optimized: one fixed-size record per finished frame in an anonymous temporary file
+  // (std::tmpfile: removed by the OS however the process ends), so memory stays flat.
+  std::FILE* frames_stream_ = nullptr;
+  std::vector<StampedPose> optimized_;
+  uint64_t optimized_without_keyframe_ = 0;
   RunStatistics statistics_;
   std::unique_ptr<MavlinkOdometrySink> mavlink_;
   // --report-every, on the track stage's thread (onPose); drops arrive on the map stage's.

@@ -29,6 +29,8 @@ Status parseSynthSpec(const std::string& spec, SynthOptions* options) {
   const std::vector<std::string> parts = splitColons(spec.substr(std::string(kSynthPrefix).size()));
   if (parts.size() > 3 || parts[0].empty()) return Status::Error(spec + ": expected synth:PRESET[:SEED[:FRAMES]]");
   options->preset = parts[0];
+  // No count given: the preset's own length (two laps for "loop", the corridor for "repeated").
+  if (presetDefaultFrames(parts[0]) > 0) options->frames = presetDefaultFrames(parts[0]);
   if (parts.size() > 1) {
     double seed = 0;
     if (!parseDouble(parts[1], &seed) || seed < 0 || seed != static_cast<double>(static_cast<uint64_t>(seed)))

@@ -66,6 +66,10 @@ InsertResult LocalMapper::insertKeyframe(const KeyframeRequest& request) {
   kf.frame_sequence = request.frame_sequence;
   kf.timestamp_s = request.timestamp_s;
   kf.T_world_cam = request.T_world_cam;
+  // Tracked against a snapshot from before the last loop correction: move it with the map.
+  if (!request.start_new_map && request.local_map_version < correction_version_) {
+    kf.T_world_cam = last_correction_ * request.T_world_cam;
+  }
   result.inserted = true;
   result.keyframe_id = kf.id;
   ++stats_.keyframes_inserted;
@@ -88,6 +92,29 @@ InsertResult LocalMapper::insertKeyframe(const KeyframeRequest& request) {
   stats_.peak.line_observations = std::max(stats_.peak.line_observations, counts.line_observations);
   publishSnapshot(kf_slot);
   return result;
+}
+
+bool LocalMapper::applyCorrection(const MapCorrection& correction) {
+  const int kf_slot = map_.findKeyframeSlot(correction.keyframe_id);
+  if (kf_slot < 0) return false;
+  const Eigen::Isometry3d C = correction.T_world_cam * map_.keyframe(kf_slot).T_world_cam.inverse();
+  for (std::size_t i = 0; i < kMaxMapKeyframes; ++i) {
+    if (map_.keyframeAlive(int(i))) map_.keyframe(int(i)).T_world_cam = C * map_.keyframe(int(i)).T_world_cam;
+  }
+  for (std::size_t i = 0; i < kMaxMapPoints; ++i) {
+    if (map_.pointAlive(int(i))) map_.point(int(i)).P_world = C * map_.point(int(i)).P_world;
+  }
+  for (std::size_t i = 0; i < kMaxMapLines; ++i) {
+    if (!map_.lineAlive(int(i))) continue;
+    MapLine& l = map_.line(int(i));
+    for (int s = 0; s < l.num_samples; ++s) l.samples_world[std::size_t(s)] = C * l.samples_world[std::size_t(s)];
+    l.start_world = C * l.start_world;
+    l.end_world = C * l.end_world;
+  }
+  last_correction_ = C;
+  publishSnapshot(map_.newestKeyframeSlot());
+  correction_version_ = local_map_->version;
+  return true;
 }
 
 void LocalMapper::applyVisibility(const KeyframeRequest& request) {

@@ -18,6 +18,7 @@
 #include "pipeline/odometry/keyframe_request.h"
 #include "pipeline/odometry/local_map.h"
 #include "pipeline/odometry/map.h"
+#include "pipeline/odometry/map_correction.h"
 #include "pipeline/odometry/odometry_options.h"
 #include "solver/camera_intrinsics.h"
 #include "solver/local_ba.h"
@@ -65,6 +66,14 @@ class LocalMapper {
   LocalMapper& operator=(const LocalMapper&) = delete;
 
   InsertResult insertKeyframe(const KeyframeRequest& request);
+  // Loop closing's correction (pipeline/odometry/map_correction.h): ONE rigid motion
+  // C = correction.T_world_cam * T_world_keyframe^-1 moves every keyframe and landmark of the map,
+  // then a new snapshot is published (the tracker follows through its reference keyframe).
+  // Covariances are unchanged (they live in each camera's frame). A keyframe request built against
+  // an older snapshot arrives in the old frame: insertKeyframe() moves its pose by the newest C
+  // (one correction in flight is assumed; corrections are seconds apart). false (nothing changed)
+  // when the keyframe is no longer in the map.
+  bool applyCorrection(const MapCorrection& correction);
   // The snapshot published after the last insertion (version 0 before any).
   const LocalMap& localMap() const { return *local_map_; }
   const Map& map() const { return map_; }
@@ -101,6 +110,9 @@ class LocalMapper {
   LocalBundleAdjuster ba_;
   uint32_t segment_ = 0;
   uint64_t snapshot_version_ = 0;
+  // The last correction: snapshots older than this version are in the frame before it.
+  uint64_t correction_version_ = 0;
+  Eigen::Isometry3d last_correction_ = Eigen::Isometry3d::Identity();
   MapperStats stats_;
   FixedVector<RetiredKeyframe, kMaxMapKeyframes> retired_;
 

@@ -18,6 +18,8 @@ struct OdometryStats {
   // Frames the output queue could not take because the caller did not drain it (never with the
   // runner, which drains after every frame): counted, never silently overwritten.
   uint64_t output_overflows = 0;
+  uint64_t loop_corrections_applied = 0;  // loop closing moved the local map
+  uint64_t loop_corrections_stale = 0;    // its keyframe had left the map: not applied
 };
 
 }  // namespace plumb

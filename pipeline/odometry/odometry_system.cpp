@@ -57,7 +57,8 @@ OdometrySystem::OdometrySystem(const PinholeCamera& camera, const SystemOptions&
       options_(options),
       mapping_(options.output_delay_frames),
       snapshots_(std::make_unique<runtime::LatestSnapshot<LocalMap>>()),
-      relocalizer_(std::make_unique<Relocalizer>(camera, options.odometry)) {
+      relocalizer_(std::make_unique<Relocalizer>(camera, options.odometry)),
+      corrections_(std::make_unique<runtime::LatestSnapshot<MapCorrection>>()) {
   tracking_.tracker = std::make_unique<Tracker>(camera, options.odometry);
   mapping_.mapper = std::make_unique<LocalMapper>(camera, options.odometry);
 }
@@ -200,7 +201,26 @@ void OdometrySystem::insertKeyframe(const KeyframeRequest& request) {
   mapping_.output.keyframe = true;
 }
 
+bool OdometrySystem::applyLoopCorrection() {
+  uint64_t version = 0;
+  const MapCorrection* correction = corrections_->acquireLatest(&version);
+  if (correction == nullptr || version <= mapping_.correction_version) return false;
+  mapping_.correction_version = version;
+  if (!mapping_.mapper->applyCorrection(*correction)) {
+    ++mapping_.stats.loop_corrections_stale;
+    return false;
+  }
+  ++mapping_.stats.loop_corrections_applied;
+  const LocalMap& snapshot = mapping_.mapper->localMap();
+  snapshots_->writeBuffer() = snapshot;
+  snapshots_->publish(snapshot.version);
+  for (const LocalMapKeyframe& kf : snapshot.keyframes) relocalizer_->updatePose(kf.id, kf.T_world_cam);
+  return true;
+}
+
 const FrameOutput& OdometrySystem::mapFrame(const TrackedFrame& tracked) {
+  // A loop correction first: this frame's keyframe (if any) is inserted into the corrected map.
+  applyLoopCorrection();
   mapping_.output = tracked.output;
   uint32_t reference_id = tracked.reference_id;
   Eigen::Isometry3d T_ref_cam = tracked.T_ref_cam;

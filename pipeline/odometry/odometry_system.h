@@ -30,6 +30,7 @@
 #include "pipeline/frontend/frame_features.h"
 #include "pipeline/odometry/keyframe_request.h"
 #include "pipeline/odometry/local_mapper.h"
+#include "pipeline/odometry/map_correction.h"
 #include "pipeline/odometry/mapper_fence.h"
 #include "pipeline/odometry/odometry_options.h"
 #include "pipeline/odometry/odometry_stats.h"
@@ -117,6 +118,13 @@ class OdometrySystem {
     mapping_.mapper->retireAll();
     drainRetiredKeyframes(keyframe_fn);
   }
+  // Loop closing's corrections reach the mapping side through this channel (writer: the loop
+  // stage; reader: the mapping side). mapFrame() applies the newest unapplied one before anything
+  // else (docs/LOOP.md "Correction"); applyLoopCorrection() does the same at the end of a run.
+  runtime::LatestSnapshot<MapCorrection>& loopCorrections() { return *corrections_; }
+  bool applyLoopCorrection();
+  // The mapper, read by the mapping side's own thread (loop records).
+  const LocalMapper& mapper() const { return *mapping_.mapper; }
   const OdometryStats& stats() const { return mapping_.stats; }
   // Tracking side: how often tracking waited for a lagging mapper (max_frames_ahead_of_mapper).
   uint64_t mapperWaits() const { return tracking_.mapper_waits; }
@@ -143,6 +151,7 @@ class OdometrySystem {
     OdometryTrajectory trajectory;
     OdometryStats stats;
     FrameOutput output;
+    uint64_t correction_version = 0;  // newest loop correction seen (0: none)
     explicit MappingSide(int delay_frames) : trajectory(delay_frames) {}
   };
 
@@ -166,6 +175,7 @@ class OdometrySystem {
   std::unique_ptr<runtime::LatestSnapshot<LocalMap>> snapshots_;
   std::atomic<uint64_t> keyframe_requests_done_{0};
   std::unique_ptr<Relocalizer> relocalizer_;
+  std::unique_ptr<runtime::LatestSnapshot<MapCorrection>> corrections_;
 };
 
 }  // namespace plumb

@@ -24,6 +24,10 @@ bool OdometryTrajectory::push(uint64_t sequence, double timestamp_s, bool valid,
 
 FinishedFrame OdometryTrajectory::resolve(const LocalMap& map, const Pending& p) const {
   FinishedFrame out = p.frame;
+  out.reference_id = p.reference_id;
+  out.T_ref_cam = p.T_ref_cam;
+  // Delay 0 means poses as tracked (docs): the reference keyframe's own local BA must not move
+  // them; with a delay they follow their reference keyframe's refinements.
   if (p.reference_id == 0 || delay_ == 0) return out;
   for (const LocalMapKeyframe& kf : map.keyframes) {
     if (kf.id == p.reference_id) {

@@ -23,6 +23,10 @@ struct FinishedFrame {
   bool valid = false;  // false: no pose (lost / not initialised)
   bool dropped = false;  // never processed (real-time replay found no free slot); valid is false
   Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
+  // The keyframe the pose was expressed against (0: none) and the pose relative to it: loop
+  // closing's optimised trajectory re-expresses the frame through that keyframe's final pose.
+  uint32_t reference_id = 0;
+  Eigen::Isometry3d T_ref_cam = Eigen::Isometry3d::Identity();
 };
 
 class OdometryTrajectory {

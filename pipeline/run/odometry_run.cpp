@@ -2,6 +2,9 @@
 
 #include <opencv2/core/utility.hpp>
 
+#include <algorithm>
+
+#include "pipeline/run/loop_stage.h"
 #include "pipeline/run/odometry_stages.h"
 #include "runtime/stage_runner.h"
 
@@ -15,6 +18,14 @@ Status validate(const OdometryRunOptions& options) {
     return Status::Error("max_frames must be a positive count (or -1: every frame)");
   }
   return Status::Ok();
+}
+
+bool LoopRunResult::keyframePose(uint32_t id, Eigen::Isometry3d* T_world_cam) const {
+  const auto it = std::lower_bound(keyframes.begin(), keyframes.end(), id,
+                                   [](const std::pair<uint32_t, Eigen::Isometry3d>& k, uint32_t v) { return k.first < v; });
+  if (it == keyframes.end() || it->first != id) return false;
+  *T_world_cam = it->second;
+  return true;
 }
 
 Status runOdometry(FrameCapture& capture, OdometrySystem& system, OdometrySink& sink,
@@ -48,10 +59,24 @@ Status runOdometry(FrameCapture& capture, OdometrySystem& system, OdometrySink& 
   CaptureStage capture_stage(capture, options.max_frames, options.stop, drops);
   ExtractStage extract(system);
   TrackStage track(system, fence, sink);
-  MapStage map(system, fence, drops, sink, options.warmup_frames);
+  std::unique_ptr<LoopStage> loop;
+  if (options.loop_closing) {
+    // Off the latency path like the map stage: nice 5 in real-time mode.
+    // Its own thread only where the stages have theirs (not lock-step, not the one-thread
+    // simulation of real time).
+    loop = std::make_unique<LoopStage>(system, options.loop, !lock_step && !simulated,
+                                       schedule.mode == runtime::RunMode::kRealtime ? 5 : 0);
+    loop->start();
+  }
+  MapStage map(system, fence, drops, sink, options.warmup_frames, loop.get());
   runtime::StageRunner<OdometrySlot> runner(capture_stage, {&extract, &track, &map}, schedule);
   Status status = runner.run();
   if (status.ok()) status = map.finishStatus();
+  if (loop) {
+    // The loop stage catches up; its last correction reaches the map before the final poses.
+    loop->finish();
+    system.applyLoopCorrection();
+  }
 
   // Whatever ended the run, every pose computed so far (those held back for refinement too) and
   // every keyframe reach the sink.
@@ -61,9 +86,27 @@ Status runOdometry(FrameCapture& capture, OdometrySystem& system, OdometrySink& 
         if (finish_status.ok()) finish_status = sink.onFinishedFrame(f);
       },
       [&](const RetiredKeyframe& kf) {
+        if (loop) loop->keyframeRetired(kf, system.stats().loop_corrections_applied);
         if (finish_status.ok()) finish_status = sink.onRetiredKeyframe(kf);
       });
   if (status.ok()) status = finish_status;
+  if (loop) {
+    loop->finalOptimise();
+    LoopRunResult& r = result->loop;
+    r.enabled = true;
+    r.stats = loop->stats();
+    r.records_dropped = loop->recordsDropped();
+    r.corrections_published = loop->correctionsPublished();
+    r.capacity = loop->closer().capacity();
+    r.memory_bytes = loop->closer().memoryBytes();
+    r.keyframes.clear();
+    r.keyframes.reserve(loop->closer().size());
+    for (std::size_t i = 0; i < loop->closer().size(); ++i) {
+      Eigen::Isometry3d T;
+      const uint32_t id = loop->closer().idAt(i);
+      if (loop->closer().pose(id, &T)) r.keyframes.emplace_back(id, T);
+    }
+  }
 
   result->report = runner.report();
   if (options.keep_trace) result->trace = runner.trace();

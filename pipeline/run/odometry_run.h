@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "pipeline/loop/loop_closer.h"
 #include "pipeline/odometry/odometry_system.h"
 #include "platform/status.h"
 #include "runtime/run_options.h"
@@ -61,6 +62,11 @@ struct OdometryRunOptions {
   // Set (e.g. by a SIGINT handler) to end the run after the frames already read: a clean end of
   // input, so everything computed so far reaches the sink. nullptr: never.
   const std::atomic<bool>* stop = nullptr;
+  // Loop closing (docs/LOOP.md): a loop stage after the map stage (lock-step in deterministic
+  // mode, its own thread otherwise). On by default: on synth:loop it halves the optimised ATE and
+  // on head250 and synth:repeated it accepts no loop (docs/LOOP.md "Measurements").
+  bool loop_closing = true;
+  loop::LoopCloserOptions loop;
 
   static runtime::RunOptions defaultSchedule() {
     runtime::RunOptions o;
@@ -73,7 +79,23 @@ struct OdometryRunOptions {
 // Empty Status when usable; otherwise what is wrong (checked by runOdometry before any work).
 Status validate(const OdometryRunOptions& options);
 
+// What loop closing did in a run (loop_closing on).
+struct LoopRunResult {
+  bool enabled = false;
+  loop::LoopStats stats;
+  uint64_t records_dropped = 0;        // threaded modes: the ring to the loop stage was full
+  uint64_t corrections_published = 0;  // accepted loops sent to the mapping side
+  std::size_t capacity = 0;            // keyframes the graph may hold
+  std::size_t memory_bytes = 0;        // LoopCloser::memoryBytes()
+  // Every keyframe of the final graph (id ascending) with its optimised pose: the optimised
+  // trajectory re-expresses each frame through its reference keyframe's pose here.
+  std::vector<std::pair<uint32_t, Eigen::Isometry3d>> keyframes;
+  // The pose of `id` in the final graph; false when it is not there (culled, or never received).
+  bool keyframePose(uint32_t id, Eigen::Isometry3d* T_world_cam) const;
+};
+
 struct OdometryRunResult {
+  LoopRunResult loop;
   runtime::RunReport report;
   std::vector<runtime::TraceTrack> trace;  // keep_trace
   uint64_t frames = 0;          // frames tracked (not dropped)

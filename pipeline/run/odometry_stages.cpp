@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "pipeline/run/loop_stage.h"
 #include "pipeline/run/odometry_run.h"
 #include "platform/allocation_counter.h"
 
@@ -79,6 +80,7 @@ Status MapStage::deliver(const FrameOutput& out) {
     if (status.ok()) status = sink_.onFinishedFrame(f);
   });
   system_.drainRetiredKeyframes([&](const RetiredKeyframe& kf) {
+    if (loop_ != nullptr) loop_->keyframeRetired(kf, system_.stats().loop_corrections_applied);
     if (status.ok()) status = sink_.onRetiredKeyframe(kf);
   });
   return status;
@@ -98,7 +100,10 @@ Status MapStage::writeDrops(uint32_t count) {
 Status MapStage::process(OdometrySlot& slot, const runtime::FrameStamps& stamps) {
   Status status = writeDrops(slot.dropped_before);
   ++frames_;
-  const Status s = deliver(system_.mapFrame(*slot.tracked));
+  const FrameOutput& out = system_.mapFrame(*slot.tracked);
+  // Before the fence releases the mapper: the record reads the mapper's poses.
+  if (loop_ != nullptr) loop_->keyframeInserted(*slot.tracked, out);
+  const Status s = deliver(out);
   if (status.ok()) status = s;
   // Process-wide count, read on this thread after each frame: from the first frame at or after
   // warm-up to the last one finished before the input ended, every thread's allocations are

@@ -16,6 +16,7 @@
 namespace plumb {
 
 class OdometrySink;
+class LoopStage;
 
 // What one slot carries through the stages, allocated once with the pool. FrameFeatures and
 // TrackedFrame are large (fixed capacities), so they live on the heap.
@@ -94,8 +95,10 @@ class TrackStage final : public runtime::Stage<OdometrySlot> {
 // Stage 3: local mapping for keyframe requests, the output trajectory, the sink.
 class MapStage final : public runtime::Stage<OdometrySlot> {
  public:
-  MapStage(OdometrySystem& system, MapperFence& fence, DropLog& drops, OdometrySink& sink, uint64_t warmup_frames)
-      : system_(system), fence_(fence), drops_(drops), sink_(sink), warmup_frames_(warmup_frames) {}
+  // loop may be nullptr (loop closing off); otherwise it hears of every inserted keyframe.
+  MapStage(OdometrySystem& system, MapperFence& fence, DropLog& drops, OdometrySink& sink, uint64_t warmup_frames,
+           LoopStage* loop = nullptr)
+      : system_(system), fence_(fence), drops_(drops), sink_(sink), warmup_frames_(warmup_frames), loop_(loop) {}
   const char* name() const override { return "map"; }
   Status process(OdometrySlot& slot, const runtime::FrameStamps& stamps) override;
   // Frames dropped after the last processed one (the capture has finished).
@@ -115,6 +118,7 @@ class MapStage final : public runtime::Stage<OdometrySlot> {
   DropLog& drops_;
   OdometrySink& sink_;
   uint64_t warmup_frames_;
+  LoopStage* loop_;
   Status finish_status_;
   uint64_t frames_ = 0, frames_dropped_ = 0;
   uint64_t frames_after_warmup_ = 0;

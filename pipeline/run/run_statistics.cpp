@@ -94,6 +94,34 @@ std::string runSummaryJson(const RunSummary& r) {
                     o.tracker.use_lines ? "true" : "false", o.extractor.min_line_inliers, o.extractor.num_features,
                     o.extractor.num_levels, o.extractor.max_lines, o.mapper.ba_optimised_keyframes,
                     o.mapper.ba_iterations));
+  // Loop closing (docs/LOOP.md): graph size, loops found and rejected by reason, optimisation time.
+  const LoopRunResult& lr = r.run->loop;
+  if (!lr.enabled) {
+    out += "  \"loop_closing\": {\"enabled\": false},\n";
+  } else {
+    const loop::LoopStats& ls = lr.stats;
+    add(std::snprintf(buf, sizeof(buf),
+                      "  \"loop_closing\": {\"enabled\": true, \"graph_keyframes\": %" PRIu64 ", \"peak_graph_keyframes\": %" PRIu64
+                      ", \"capacity\": %zu, \"memory_bytes\": %zu, \"keyframes_received\": %" PRIu64
+                      ", \"records_dropped\": %" PRIu64 ", \"culled\": %" PRIu64 ",\n",
+                      ls.graph_nodes, ls.peak_graph_nodes, lr.capacity, lr.memory_bytes, ls.keyframes,
+                      lr.records_dropped, ls.culled));
+    add(std::snprintf(buf, sizeof(buf),
+                      "    \"queries\": %" PRIu64 ", \"consistent_candidates\": %" PRIu64 ", \"verifications\": %" PRIu64
+                      ", \"loops_found\": %" PRIu64 ", \"loop_edges\": %" PRIu64 ", \"corrections_applied\": %" PRIu64
+                      ", \"corrections_stale\": %" PRIu64 ",\n",
+                      ls.queries, ls.consistent_candidates, ls.verifications, ls.loops_accepted, ls.loop_edges,
+                      s.loop_corrections_applied, s.loop_corrections_stale));
+    out += "    \"loops_rejected\": {";
+    for (int i = 1; i < loop::kNumLoopRejections; ++i) {
+      add(std::snprintf(buf, sizeof(buf), "%s\"%s\": %" PRIu64, i > 1 ? ", " : "",
+                        loop::toString(loop::LoopRejection(i)), ls.rejected[i]));
+    }
+    out += "},\n";
+    add(std::snprintf(buf, sizeof(buf),
+                      "    \"edges_refined\": %" PRIu64 ", \"optimisations\": %" PRIu64 ", \"optimisation_ms_total\": %.3f, \"optimisation_ms_max\": %.3f},\n",
+                      ls.edges_refined, ls.optimisations, ls.optimisation_ms_total, ls.optimisation_ms_max));
+  }
   out += "  \"rss_checkpoints\": [";
   const std::vector<RssCheckpoint>& rss = r.statistics->rss();
   for (std::size_t i = 0; i < rss.size(); ++i) {

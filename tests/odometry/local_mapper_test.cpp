@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "pipeline/odometry/local_mapper.h"
-#include "tests/odometry/synthetic_features.h"
+#include "tests/support/synthetic_features.h"
 
 namespace plumb {
 namespace {
@@ -349,6 +349,73 @@ TEST(LocalMapper, NewMapRetiresTheOldSegment) {
   EXPECT_EQ(fx.mapper->retired()[0].frame_sequence, 0u);
   EXPECT_EQ(fx.mapper->retired()[1].frame_sequence, 1u);
   EXPECT_EQ(fx.mapper->map().counts().points, 150u);
+}
+
+}  // namespace
+}  // namespace plumb
+
+namespace plumb {
+namespace {
+
+// Loop closing's correction (docs/LOOP.md "Correction"): one rigid motion of the whole local map,
+// a new snapshot, and a request tracked against the old snapshot lands in the corrected frame.
+TEST(LocalMapper, LoopCorrectionMovesTheWholeMapRigidlyAndLateRequestsFollow) {
+  const test::Scene scene = test::makeScene(15, 300, 20, kStart, 1.5, 5.0);
+  Fixture fx;
+  Eigen::Isometry3d T = kStart;
+  fx.mapper->insertKeyframe(*test::newMapRequest(test::observe(scene, T), T, 0));
+  const Eigen::Isometry3d step = pose(0.5, Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0.01, 0, 0.005));
+  for (int i = 1; i <= 2; ++i) {
+    T = T * step;
+    ASSERT_TRUE(fx.mapper->insertKeyframe(*trackedRequest(test::observe(scene, T), T, uint64_t(i), fx.mapper->localMap()))
+                    .inserted);
+  }
+  const LocalMap before = fx.mapper->localMap();
+  ASSERT_EQ(before.keyframes.size(), 3u);
+  ASSERT_GT(before.points.size(), 100u);
+  ASSERT_GT(before.lines.size(), 3u);
+
+  const Eigen::Isometry3d C = pose(4, Eigen::Vector3d(0.3, 1, 0.2), Eigen::Vector3d(0.12, -0.05, 0.3));
+  MapCorrection correction;
+  correction.keyframe_id = before.reference_keyframe_id;
+  correction.T_world_cam = C * before.T_world_reference;
+  EXPECT_FALSE(fx.mapper->applyCorrection(MapCorrection{9999, Eigen::Isometry3d::Identity()}));
+  ASSERT_TRUE(fx.mapper->applyCorrection(correction));
+  const LocalMap& after = fx.mapper->localMap();
+  EXPECT_GT(after.version, before.version);
+  ASSERT_EQ(after.keyframes.size(), before.keyframes.size());
+  for (std::size_t i = 0; i < after.keyframes.size(); ++i) {
+    EXPECT_EQ(after.keyframes[i].id, before.keyframes[i].id);
+    EXPECT_LT(translationError(after.keyframes[i].T_world_cam, C * before.keyframes[i].T_world_cam), 1e-9);
+    EXPECT_LT(test::rotationErrorDeg(after.keyframes[i].T_world_cam, C * before.keyframes[i].T_world_cam), 1e-7);
+  }
+  ASSERT_EQ(after.points.size(), before.points.size());
+  for (std::size_t i = 0; i < after.points.size(); ++i) {
+    EXPECT_EQ(after.points[i].ref.id, before.points[i].ref.id);
+    EXPECT_LT((after.points[i].P_world - C * before.points[i].P_world).norm(), 1e-9);
+  }
+  ASSERT_EQ(after.lines.size(), before.lines.size());
+  for (std::size_t i = 0; i < after.lines.size(); ++i) {
+    for (int s = 0; s < after.lines[i].num_samples; ++s) {
+      EXPECT_LT((after.lines[i].samples_world[std::size_t(s)] - C * before.lines[i].samples_world[std::size_t(s)]).norm(),
+                1e-9);
+    }
+    EXPECT_LT((after.lines[i].start_world - C * before.lines[i].start_world).norm(), 1e-9);
+  }
+
+  // The tracker built this request against the snapshot from before the correction: its pose is
+  // in the old frame, and is inserted moved by C (the associations still hold).
+  T = T * step;
+  const auto late = trackedRequest(test::observe(scene, T), T, 3, before);
+  ASSERT_LT(late->local_map_version, after.version);
+  const InsertResult r = fx.mapper->insertKeyframe(*late);
+  ASSERT_TRUE(r.inserted);
+  EXPECT_EQ(r.ba_outliers, 0);
+  EXPECT_LT(translationError(fx.mapper->localMap().T_world_reference, C * T), 1e-4);
+  // A request made against the corrected snapshot is taken as it is.
+  const auto current = trackedRequest(test::observe(scene, T * step), C * T * step, 4, fx.mapper->localMap());
+  ASSERT_TRUE(fx.mapper->insertKeyframe(*current).inserted);
+  EXPECT_LT(translationError(fx.mapper->localMap().T_world_reference, C * T * step), 1e-4);
 }
 
 }  // namespace

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "pipeline/odometry/odometry_trajectory.h"
-#include "tests/odometry/synthetic_features.h"
+#include "tests/support/synthetic_features.h"
 
 namespace plumb {
 namespace {

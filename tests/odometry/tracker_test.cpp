@@ -8,7 +8,7 @@
 
 #include "pipeline/odometry/local_mapper.h"
 #include "pipeline/odometry/tracker.h"
-#include "tests/odometry/synthetic_features.h"
+#include "tests/support/synthetic_features.h"
 
 namespace plumb {
 namespace {

@@ -350,3 +350,60 @@ TEST(PoseGraph, OptimizeMakesZeroAllocationsOnAnAnalysedStructure) {
 
 }  // namespace
 }  // namespace plumb::testing
+
+namespace plumb::testing {
+namespace {
+
+// reserveChainWithExtraEdges(): a chain with noisy loop edges solved in natural order gives the
+// AMD-ordered solution, and rebuilding and re-analysing growing graphs allocates nothing through
+// operator new once the storage is reserved.
+TEST(PoseGraph, ChainWithExtraEdgesNaturalOrderMatchesAmdAndReanalysesWithoutNew) {
+  const int n = 120, loops = 12;
+  std::mt19937 rng(77);
+  std::vector<Eigen::Isometry3d> T_true, T_start;
+  for (int k = 0; k < n; ++k) {
+    const double a = 4.0 * M_PI * k / n;  // two laps
+    Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
+    T_world_cam.linear() = expSO3(Eigen::Vector3d(0.05 * std::sin(a), 0.0, a));
+    T_world_cam.translation() = Eigen::Vector3d(2.0 * std::cos(a), 2.0 * std::sin(a), 0.1 * std::sin(3 * a));
+    T_true.push_back(T_world_cam.inverse());
+    T_start.push_back(k == 0 ? T_true[0] : expSE3(randomTangent(rng, 0.05, 0.03)) * T_true[k]);
+  }
+  std::vector<std::pair<int, int>> extra;
+  for (int l = 0; l < loops; ++l) extra.emplace_back(5 + 3 * l, n / 2 + 5 + 3 * l);
+  std::vector<Matrix6d> information;
+  for (int e = 0; e < n - 1 + loops; ++e) information.push_back(randomInformation(rng, 0.02, 0.01));
+  auto build = [&](PoseGraph& g, int nodes) {
+    g.clear();
+    for (int k = 0; k < nodes; ++k) ASSERT_EQ(g.addNode(k, T_start[k], k == 0), k);
+    for (int k = 1; k < nodes; ++k) ASSERT_GE(g.addEdge(k - 1, k, T_true[k - 1] * T_true[k].inverse(), information[k - 1]), 0);
+    for (int l = 0; l < loops; ++l) {
+      if (extra[l].second >= nodes) continue;
+      ASSERT_GE(g.addEdge(extra[l].first, extra[l].second, T_true[extra[l].first] * T_true[extra[l].second].inverse(),
+                          information[n - 1 + l]),
+                0);
+    }
+  };
+  PoseGraph amd(n, n + loops), natural(n, n + loops);
+  natural.reserveChainWithExtraEdges(loops);
+  build(amd, n);
+  build(natural, n);
+  const PoseGraphSummary a = amd.optimize(PoseGraphOptions{});
+  const PoseGraphSummary b = natural.optimize(PoseGraphOptions{});
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_NEAR(a.final_cost, b.final_cost, 1e-9 * (1 + a.final_cost));
+  for (int k = 0; k < n; ++k) {
+    EXPECT_LT(translationDifference(natural.pose(k), T_true[k]), 1e-6) << k;
+    EXPECT_LT(translationDifference(natural.pose(k), amd.pose(k)), 1e-8) << k;
+  }
+  // Growing structures, each analysed afresh: no operator new.
+  const uint64_t before = allocationCount();
+  for (int nodes = n / 2 + 10; nodes <= n; nodes += 10) {
+    build(natural, nodes);
+    EXPECT_TRUE(natural.optimize(PoseGraphOptions{}).ok());
+  }
+  EXPECT_EQ(allocationCount() - before, 0u);
+}
+
+}  // namespace
+}  // namespace plumb::testing

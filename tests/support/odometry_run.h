@@ -21,6 +21,10 @@ namespace plumb::test {
 struct OdometryRun {
   Status status;
   std::vector<StampedPose> trajectory;  // one per input frame, in order
+  // The optimised trajectory (docs/LOOP.md): each frame through its reference keyframe's pose in
+  // the final loop-closing graph; the real-time pose where the keyframe is not in the graph.
+  std::vector<StampedPose> optimized;
+  std::vector<std::pair<uint32_t, Eigen::Isometry3d>> references;  // per frame: (id, T_ref_cam)
   std::vector<FrameOutput> outputs;     // per frame as mapped (when asked for)
   OdometryStats stats;
   MapperStats mapper;
@@ -48,6 +52,7 @@ class CollectingSink final : public OdometrySink {
     p.valid = f.valid;
     p.dropped = f.dropped;
     run_->trajectory.push_back(p);
+    run_->references.emplace_back(f.reference_id, f.T_ref_cam);
     return Status::Ok();
   }
 
@@ -61,6 +66,7 @@ struct RunSettings {
   long max_frames = -1;
   runtime::RunMode mode = runtime::RunMode::kDeterministic;
   bool keep_outputs = false;
+  bool loop_closing = true;
 };
 
 inline OdometryRun runOdometry(FrameSource& source, const SystemOptions& options, const RunSettings& settings = {}) {
@@ -73,7 +79,15 @@ inline OdometryRun runOdometry(FrameSource& source, const SystemOptions& options
   OdometryRunOptions run_options;
   run_options.schedule.mode = settings.mode;
   run_options.max_frames = settings.max_frames;
+  run_options.loop_closing = settings.loop_closing;
   run.status = runOdometry(capture, *system, sink, run_options, &run.result);
+  run.optimized = run.trajectory;
+  for (std::size_t i = 0; i < run.optimized.size(); ++i) {
+    Eigen::Isometry3d T_world_ref;
+    if (run.optimized[i].valid && run.result.loop.keyframePose(run.references[i].first, &T_world_ref)) {
+      run.optimized[i].T_world_cam = T_world_ref * run.references[i].second;
+    }
+  }
   run.stats = system->stats();
   run.mapper = system->mapperStats();
   return run;

@@ -75,6 +75,31 @@ TEST(RunCli, TwoLineSamplesTrackWithLines) {
   EXPECT_EQ(json.find("\"lines_created\": 0,"), std::string::npos) << json;
 }
 
+// --out-optimized: one line per frame like --out; without loop closing there is no graph, so the
+// two files are the same bytes (docs/LOOP.md "Two trajectories").
+TEST(RunCli, OutOptimizedHasEveryFrameAndEqualsOutWithoutLoops) {
+  ScratchDir dir("plumb_run_cli");
+  ASSERT_TRUE(dir.ok());
+  const std::string a = dir.file("a.txt"), b = dir.file("b.txt");
+  RunResult r = runPlumb("run --dataset synth:textured:1:40 --no-loops --out '" + a + "' --out-optimized '" + b + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream ia(a, std::ios::binary), ib(b, std::ios::binary);
+  const std::string sa((std::istreambuf_iterator<char>(ia)), std::istreambuf_iterator<char>());
+  const std::string sb((std::istreambuf_iterator<char>(ib)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(std::count(sa.begin(), sa.end(), '\n'), 41);  // header + 40 frames
+  EXPECT_EQ(sa, sb);
+  // With loop closing (no loop in 40 frames): still one line per frame, and the statistics say so.
+  const std::string stats = dir.file("s.json");
+  r = runPlumb("run --dataset synth:textured:1:40 --out '" + a + "' --out-optimized '" + b + "' --stats '" + stats + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream ib2(b, std::ios::binary), is(stats);
+  const std::string sb2((std::istreambuf_iterator<char>(ib2)), std::istreambuf_iterator<char>());
+  const std::string json((std::istreambuf_iterator<char>(is)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(std::count(sb2.begin(), sb2.end(), '\n'), 41);
+  EXPECT_NE(json.find("\"loop_closing\": {\"enabled\": true"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"loops_found\": 0"), std::string::npos) << json;
+}
+
 }  // namespace
 }  // namespace plumb::test
 
@@ -114,7 +139,7 @@ TEST_F(RunDataSafety, OutputOverAFileOfTheInputFolderIsRefused) {
     const std::string victim = dataset_ + "/" + name;
     const std::string before = readAll(victim);
     ASSERT_FALSE(before.empty()) << name;
-    for (const std::string flag : {"--out", "--stats", "--covariance"}) {
+    for (const std::string flag : {"--out", "--stats", "--covariance", "--out-optimized"}) {
       std::string args = "run --dataset '" + dataset_ + "' " + flag + " '" + victim + "'";
       if (flag != "--out") args += " --out '" + dir_.file("t.txt") + "'";
       const RunResult r = runPlumb(args);

@@ -1,0 +1,348 @@
+#include "pipeline/loop/loop_closer.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+
+#include "solver/se3.h"
+#include "solver/se3_jacobians.h"
+
+namespace plumb::loop {
+
+namespace {
+
+KeyframeDatabaseOptions databaseOptions(const LoopCloserOptions& o) {
+  KeyframeDatabaseOptions d;
+  d.max_keyframes = o.capacity + 1;  // the newest is inserted before the oldest is culled
+  d.max_point_descriptors = int(kMaxLoopPoints);
+  d.max_line_descriptors = int(kMaxLoopLines);
+  d.max_postings = (o.capacity + 1) * int(kMaxLoopPoints + kMaxLoopLines);  // every descriptor its own word
+  d.bits_per_word = o.bits_per_word;
+  return d;
+}
+
+Matrix6d diagonalCovariance(double sigma_t, double sigma_r) {
+  Matrix6d c = Matrix6d::Zero();
+  c.diagonal() << sigma_t * sigma_t, sigma_t * sigma_t, sigma_t * sigma_t, sigma_r * sigma_r,
+      sigma_r * sigma_r, sigma_r * sigma_r;
+  return c;
+}
+
+Matrix6d inverseSpd(const Matrix6d& m) {
+  const Eigen::LDLT<Matrix6d> ldlt(m);
+  return ldlt.solve(Matrix6d::Identity());
+}
+
+bool finiteSpd(const Matrix6d& m) {
+  if (!m.allFinite()) return false;
+  const Eigen::LLT<Matrix6d> llt(0.5 * (m + m.transpose()));
+  return llt.info() == Eigen::Success;
+}
+
+double poseDistance(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  const double dt = (a.translation() - b.translation()).norm();
+  const double dr = Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle();
+  return dt + 0.5 * dr;  // 0.5 m per radian: a 10 cm step and a 11 deg turn weigh the same
+}
+
+}  // namespace
+
+LoopCloser::LoopCloser(const CameraIntrinsics& camera, const NoiseModelOptions& noise,
+                       const LoopCloserOptions& options)
+    : options_(options),
+      verifier_(camera, noise, options.verifier),
+      database_(databaseOptions(options)),
+      graph_(options.capacity + 1, options.capacity + 1 + options.max_loop_edges),
+      records_(new LoopKeyframe[std::size_t(options.capacity + 1)]),
+      nodes_(std::size_t(options.capacity + 1)) {
+  // Odometry chain + loop edges: natural order, factor storage reserved here (no allocation by
+  // operator new in later analyses).
+  graph_.reserveChainWithExtraEdges(options.max_loop_edges);
+  free_slots_.reserve(std::size_t(options.capacity + 1));
+  for (int s = options.capacity; s >= 0; --s) free_slots_.push_back(s);
+  order_.reserve(std::size_t(options.capacity + 1));
+  loop_edges_.reserve(std::size_t(options.max_loop_edges));
+}
+
+LoopCloser::~LoopCloser() = default;
+
+std::size_t LoopCloser::memoryBytesFor(const LoopCloserOptions& o) {
+  const std::size_t slots = std::size_t(o.capacity + 1);
+  // Pose graph: nodes (~2 isometries), edges (isometry + 6x6 + kernel), blocks; H's pattern and
+  // the factor (allocated in analyze(), bounded by the structure) are not counted here.
+  const std::size_t graph = slots * 300 + (slots + std::size_t(o.max_loop_edges)) * 450;
+  // reserveChainWithExtraEdges(): H and the factor's value + index arrays (12 bytes an entry).
+  const std::size_t edges = slots + 1 + std::size_t(o.max_loop_edges);
+  const std::size_t sparse =
+      12 * (21 * slots + 36 * edges + slots * (15 + 36 * (1 + std::size_t(o.max_loop_edges))));
+  return sizeof(LoopCloser) + slots * (sizeof(LoopKeyframe) + sizeof(Node) + 2 * sizeof(int)) +
+         std::size_t(o.max_loop_edges) * sizeof(LoopEdge) +
+         KeyframeDatabase::memoryBytesFor(databaseOptions(o)) + graph + sparse + sizeof(LoopVerifier) +
+         110 * 1024;  // verifier scratch (~105 KB)
+}
+
+std::size_t LoopCloser::memoryBytes() const { return memoryBytesFor(options_); }
+
+int LoopCloser::findPosition(uint32_t id) const {
+  // order_ is sorted by id: binary search.
+  int lo = 0, hi = int(order_.size()) - 1;
+  while (lo <= hi) {
+    const int mid = (lo + hi) / 2;
+    const uint32_t m = nodes_[std::size_t(order_[std::size_t(mid)])].id;
+    if (m == id) return mid;
+    if (m < id)
+      lo = mid + 1;
+    else
+      hi = mid - 1;
+  }
+  return -1;
+}
+
+bool LoopCloser::pose(uint32_t keyframe_id, Eigen::Isometry3d* T_world_cam) const {
+  const int p = findPosition(keyframe_id);
+  if (p < 0) return false;
+  *T_world_cam = nodes_[std::size_t(order_[std::size_t(p)])].T_world_cam;
+  return true;
+}
+
+Matrix6d LoopCloser::edgeCovariance(bool new_segment, const Matrix6d& covariance,
+                                    bool covariance_valid) const {
+  if (new_segment)
+    return diagonalCovariance(options_.segment_translation_sigma_m, options_.segment_rotation_sigma_rad);
+  if (covariance_valid && finiteSpd(covariance)) {
+    return 0.5 * (covariance + covariance.transpose()) +
+           diagonalCovariance(options_.floor_translation_sigma_m, options_.floor_rotation_sigma_rad);
+  }
+  return diagonalCovariance(options_.default_translation_sigma_m, options_.default_rotation_sigma_rad);
+}
+
+void LoopCloser::addNode(const LoopKeyframe& r, int slot) {
+  Node& n = nodes_[std::size_t(slot)];
+  n = Node{};
+  n.id = r.id;
+  if (order_.empty()) {
+    n.T_world_cam = r.T_world_cam;  // the graph's frame is the first keyframe's mapping frame
+  } else {
+    const Node& previous = nodes_[std::size_t(order_.back())];
+    const LoopKeyframe& previous_record = records_[std::size_t(order_.back())];
+    n.has_edge = true;
+    if (!r.new_segment && r.previous_id == previous.id) {
+      n.previous_map_id = r.previous_id;
+      n.T_previous_this = r.T_previous_this;
+      n.edge_covariance = edgeCovariance(r.new_segment, r.covariance, r.covariance_valid);
+    } else {
+      // A new segment, or the previous keyframe's record never arrived (full ring): the relative
+      // pose of the two records as the mapping side had them, with the weak segment covariance.
+      n.T_previous_this = previous_record.T_world_cam.inverse() * r.T_world_cam;
+      n.edge_covariance =
+          diagonalCovariance(options_.segment_translation_sigma_m, options_.segment_rotation_sigma_rad);
+    }
+    n.edge_length_m = n.T_previous_this.translation().norm();
+    n.T_world_cam = previous.T_world_cam * n.T_previous_this;
+  }
+  order_.push_back(slot);
+}
+
+bool LoopCloser::addKeyframe(const LoopKeyframe& record) {
+  ++stats_.keyframes;
+  if (!order_.empty() && record.id <= nodes_[std::size_t(order_.back())].id) return false;  // out of order
+  if (free_slots_.empty()) return false;  // cannot happen: culling keeps one slot free
+  const int slot = free_slots_.back();
+  free_slots_.pop_back();
+  records_[std::size_t(slot)] = record;
+  const LoopKeyframe& r = records_[std::size_t(slot)];
+  addNode(r, slot);
+  const int query_position = int(order_.size()) - 1;
+
+  bool accepted = false;
+  // Query before inserting: a keyframe never finds itself.
+  const PlaceDescriptors descriptors{r.point_descriptors.data(), r.point_descriptors.size(),
+                                     r.line_descriptors.data(), r.line_descriptors.size()};
+  if (r.id > uint32_t(options_.min_age_keyframes)) {
+    ++stats_.queries;
+    PlaceQueryOptions q;
+    q.max_results = std::size_t(std::min<int>(options_.candidates, int(kMaxPlaceCandidates)));
+    q.max_candidate_id = uint64_t(r.id) - uint64_t(options_.min_age_keyframes);
+    q.min_score = options_.min_candidate_score;
+    database_.query(descriptors, q, &candidates_);
+    const std::size_t before = stats_.loops_accepted;
+    detect(query_position);
+    accepted = stats_.loops_accepted > before;
+  } else {
+    groups_.clear();
+  }
+  (void)database_.insert(r.id, descriptors);  // sized for capacity + 1: cannot fail
+  if (accepted) optimise();
+  if (int(order_.size()) > options_.capacity) cullOne();
+  stats_.graph_nodes = order_.size();
+  stats_.peak_graph_nodes = std::max<uint64_t>(stats_.peak_graph_nodes, order_.size());
+  stats_.loop_edges = loop_edges_.size();
+  return accepted;
+}
+
+void LoopCloser::detect(int query_position) {
+  const Node& query = nodes_[std::size_t(order_[std::size_t(query_position)])];
+  const LoopKeyframe& query_record = records_[std::size_t(order_[std::size_t(query_position)])];
+  // Consistency: each candidate inherits the count of the previous query's nearest group.
+  new_groups_.clear();
+  for (const PlaceCandidate& c : candidates_) {
+    int count = 1;
+    for (const Group& g : groups_) {
+      const int64_t d = int64_t(g.id) - int64_t(c.keyframe_id);
+      if (std::llabs(d) <= options_.consistency_neighbourhood) count = std::max(count, g.count + 1);
+    }
+    (void)new_groups_.push_back(Group{uint32_t(c.keyframe_id), count});
+  }
+  groups_ = new_groups_;
+  if (cooldown_ > 0) {
+    --cooldown_;
+    return;
+  }
+  int verified = 0;
+  for (const Group& g : groups_) {  // candidates_ order: best score first
+    if (g.count < options_.min_consistent || verified >= options_.max_verifications) continue;
+    ++stats_.consistent_candidates;
+    const int candidate_position = findPosition(g.id);
+    if (candidate_position < 0) continue;  // culled meanwhile
+    ++verified;
+    ++stats_.verifications;
+    const LoopKeyframe& candidate = records_[std::size_t(order_[std::size_t(candidate_position)])];
+    LoopMeasurement m = verifier_.verify(query_record, candidate);
+    if (m.accepted() && !plausible(candidate_position, query_position, m))
+      m.rejection = LoopRejection::kImplausible;
+    if (!m.accepted()) {
+      ++stats_.rejected[int(m.rejection)];
+      continue;
+    }
+    if (loop_edges_.size() >= std::size_t(options_.max_loop_edges)) loop_edges_.erase(loop_edges_.begin());
+    const Matrix6d covariance =
+        0.5 * (m.covariance + m.covariance.transpose()) +
+        diagonalCovariance(options_.floor_translation_sigma_m, options_.floor_rotation_sigma_rad);
+    loop_edges_.push_back(LoopEdge{candidate.id, query.id, m.T_candidate_query, inverseSpd(covariance)});
+    ++stats_.loops_accepted;
+    cooldown_ = options_.cooldown_keyframes;
+    return;  // one loop per keyframe
+  }
+}
+
+bool LoopCloser::plausible(int candidate_position, int query_position, const LoopMeasurement& m) const {
+  const Node& c = nodes_[std::size_t(order_[std::size_t(candidate_position)])];
+  const Node& q = nodes_[std::size_t(order_[std::size_t(query_position)])];
+  const Eigen::Isometry3d T_cam_q_world = q.T_world_cam.inverse();
+  Matrix6d sigma = 0.5 * (m.covariance + m.covariance.transpose());
+  for (int p = candidate_position + 1; p <= query_position; ++p) {
+    const Node& j = nodes_[std::size_t(order_[std::size_t(p)])];
+    const double len = j.edge_length_m;
+    const Matrix6d edge = j.edge_covariance + diagonalCovariance(options_.drift_translation_per_m * len,
+                                                                 options_.drift_rotation_rad_per_m * len);
+    const Matrix6d Ad = adjointSE3(T_cam_q_world * j.T_world_cam);  // T_q_j
+    sigma += Ad * edge * Ad.transpose();
+  }
+  sigma += diagonalCovariance(options_.floor_translation_sigma_m, options_.floor_rotation_sigma_rad);
+  const Vector6d e = poseGraphEdgeError(m.T_candidate_query, c.T_world_cam.inverse(), T_cam_q_world);
+  const double chi2 = e.dot(Eigen::LDLT<Matrix6d>(sigma).solve(e));
+  return std::isfinite(chi2) && chi2 <= options_.plausibility_chi2;
+}
+
+void LoopCloser::keyframeFinal(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam,
+                               const Matrix6d& covariance, bool covariance_valid, uint64_t epoch) {
+  const int p = findPosition(keyframe_id);
+  if (p < 0) return;
+  Node& n = nodes_[std::size_t(order_[std::size_t(p)])];
+  n.has_final = true;
+  n.final_epoch = epoch;
+  n.T_world_final = T_world_cam;
+  if (p == 0 || n.previous_map_id == 0) return;
+  const Node& previous = nodes_[std::size_t(order_[std::size_t(p - 1)])];
+  if (previous.id != n.previous_map_id || !previous.has_final || previous.final_epoch != epoch) return;
+  n.T_previous_this = previous.T_world_final.inverse() * T_world_cam;
+  n.edge_length_m = n.T_previous_this.translation().norm();
+  n.edge_covariance = edgeCovariance(false, covariance, covariance_valid);
+  edges_changed_ = true;
+  ++stats_.edges_refined;
+}
+
+void LoopCloser::finalOptimise() {
+  if (edges_changed_ && !order_.empty()) optimise();
+}
+
+void LoopCloser::optimise() {
+  edges_changed_ = false;
+  const auto start = std::chrono::steady_clock::now();
+  graph_.clear();
+  for (std::size_t p = 0; p < order_.size(); ++p) {
+    const Node& n = nodes_[std::size_t(order_[p])];
+    (void)graph_.addNode(int64_t(n.id), n.T_world_cam.inverse(), p == 0);
+    if (p > 0 && n.has_edge) {
+      (void)graph_.addEdge(int(p) - 1, int(p), n.T_previous_this, inverseSpd(n.edge_covariance));
+    }
+  }
+  const RobustKernel huber{RobustKernelType::kHuber, options_.loop_huber_delta};
+  for (const LoopEdge& e : loop_edges_) {
+    const int i = findPosition(e.candidate_id), j = findPosition(e.query_id);
+    if (i < 0 || j < 0) continue;
+    (void)graph_.addEdge(i, j, e.T_candidate_query, e.information, huber);
+  }
+  const PoseGraphSummary summary = graph_.optimize(options_.graph);
+  if (summary.ok()) {
+    for (std::size_t p = 0; p < order_.size(); ++p) {
+      nodes_[std::size_t(order_[p])].T_world_cam = graph_.pose(int(p)).inverse();
+    }
+  }
+  const Node& query = nodes_[std::size_t(order_.back())];
+  correction_.keyframe_id = query.id;
+  correction_.T_world_cam = query.T_world_cam;
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  ++stats_.optimisations;
+  stats_.optimisation_ms_total += ms;
+  stats_.optimisation_ms_max = std::max(stats_.optimisation_ms_max, ms);
+}
+
+void LoopCloser::cullOne() {
+  // Interior nodes only: not the first (the gauge), not the newest (the next record links to it).
+  int victim = -1;
+  double best = 0;
+  for (int pass = 0; pass < 2 && victim < 0; ++pass) {
+    for (int p = 1; p + 1 < int(order_.size()); ++p) {
+      const Node& n = nodes_[std::size_t(order_[std::size_t(p)])];
+      const Node& next = nodes_[std::size_t(order_[std::size_t(p + 1)])];
+      if (pass == 0) {  // first pass: keep keyframes that anchor a loop edge
+        bool anchored = false;
+        for (const LoopEdge& e : loop_edges_) anchored |= e.candidate_id == n.id || e.query_id == n.id;
+        if (anchored) continue;
+      }
+      const Node& previous = nodes_[std::size_t(order_[std::size_t(p - 1)])];
+      const double score =
+          poseDistance(previous.T_world_cam, n.T_world_cam) + poseDistance(n.T_world_cam, next.T_world_cam);
+      if (victim < 0 || score < best) {
+        victim = p;
+        best = score;
+      }
+    }
+  }
+  if (victim < 0) return;
+  const int slot = order_[std::size_t(victim)];
+  Node& r = nodes_[std::size_t(slot)];
+  Node& next = nodes_[std::size_t(order_[std::size_t(victim + 1)])];
+  // previous -> r -> next becomes previous -> next: T_p_n = T_p_r T_r_n; r's uncertainty (in r's
+  // frame) reaches next through Ad(T_n_r).
+  const Matrix6d Ad = adjointSE3(next.T_previous_this.inverse());
+  next.edge_covariance = Ad * r.edge_covariance * Ad.transpose() + next.edge_covariance;
+  next.T_previous_this = r.T_previous_this * next.T_previous_this;
+  next.edge_length_m += r.edge_length_m;
+  next.has_edge = next.has_edge && r.has_edge;
+  for (std::size_t i = 0; i < loop_edges_.size();) {
+    if (loop_edges_[i].candidate_id == r.id || loop_edges_[i].query_id == r.id) {
+      loop_edges_.erase(loop_edges_.begin() + long(i));
+    } else {
+      ++i;
+    }
+  }
+  (void)database_.remove(r.id);
+  order_.erase(order_.begin() + victim);
+  free_slots_.push_back(slot);
+  ++stats_.culled;
+}
+
+}  // namespace plumb::loop

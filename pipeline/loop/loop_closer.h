@@ -1,0 +1,172 @@
+#pragma once
+// LoopCloser: loop detection, verification and pose-graph optimisation over a FIXED number of
+// keyframe records (docs/LOOP.md). One owner thread (the loop stage).
+//
+// addKeyframe(record), for each keyframe the mapping side inserted, in id order:
+//   1. graph: a node for the keyframe, linked to the previous node by an odometry edge
+//      T_previous_this weighted by the local-BA marginal covariance (+ a floor), or by a default
+//      information when BA gave none; a new map segment is linked by a weak edge.
+//   2. detection: KeyframeDatabase query, candidates older than min_age_keyframes (outside the
+//      local window); a candidate must be consistent over min_consistent consecutive queries
+//      (each query had a candidate within consistency_neighbourhood ids of it).
+//   3. verification: LoopVerifier (ORB + LBD matching, 3D-3D RANSAC, point + line refinement).
+//   4. plausibility: the correction the loop implies at this keyframe, e = log(Z^-1 T_c T_q^-1),
+//      must be explained by the odometry uncertainty accumulated from the candidate to the query:
+//      e^T (sum_j Ad(T_q_j) (S_j + drift_j) Ad(T_q_j)^T + S_loop)^-1 e <= plausibility_chi2.
+//      (S_j: edge covariances; drift_j: a prior proportional to the distance travelled.) Repeated
+//      texture typically implies a jump of a whole module that this test refuses.
+//   5. a loop edge (Huber kernel), pose-graph LM (solver/pose_graph.h), and a MapCorrection for
+//      the query keyframe (its optimised pose) for the mapping side.
+// Lifelong bound: when `capacity` records are held, the most redundant keyframe (smallest distance
+// to its two graph neighbours; not the first, the newest, or one with a loop edge) is culled: its two
+// odometry edges are composed into one (covariances propagated), it leaves the database.
+//
+// MEMORY: everything is allocated in the constructor (memoryBytes(): 25.0 MB at the default
+// capacity 256, 7.5 MB of it the pose graph's reserved sparse arrays; docs/LOOP.md). addKeyframe() makes
+// no operator-new allocation; when a loop is accepted, PoseGraph::analyze() (the graph is rebuilt:
+// culling changes its structure) still makes a few malloc calls (Eigen's outer-index arrays).
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "pipeline/loop/keyframe_database.h"
+#include "pipeline/loop/loop_keyframe.h"
+#include "pipeline/loop/loop_verifier.h"
+#include "pipeline/odometry/map_correction.h"
+#include "solver/pose_graph.h"
+
+namespace plumb::loop {
+
+struct LoopCloserOptions {
+  int capacity = 256;          // keyframe records = database entries = graph nodes
+  int max_loop_edges = 64;     // the oldest loop edge is forgotten when full
+  int min_age_keyframes = 40;  // candidate id <= query id - this (the local map holds 32)
+  int candidates = 10;         // database results per query
+  double min_candidate_score = 0.02;
+  int consistency_neighbourhood = 4;  // candidate ids this close name the same place
+  int min_consistent = 3;             // consecutive queries agreeing, this one included
+  int max_verifications = 3;          // consistent candidates verified per query, best score first
+  int cooldown_keyframes = 3;         // after an accepted loop, keyframes not searched
+  LoopVerifierOptions verifier;
+  int bits_per_word = kDefaultWordBits;
+  // Odometry edge covariance when local BA gave none; the floor is added to BA's covariances,
+  // which know the measurement noise only (not the model errors that make odometry drift).
+  double default_translation_sigma_m = 0.02;
+  double default_rotation_sigma_rad = 0.01;
+  double floor_translation_sigma_m = 0.003;
+  double floor_rotation_sigma_rad = 0.002;
+  // The first keyframe of a new map segment: the tracker restarted at its last known pose.
+  double segment_translation_sigma_m = 1.0;
+  double segment_rotation_sigma_rad = 0.5;
+  // Plausibility (step 4): drift prior per metre travelled and the chi-square bound (6 dof,
+  // 99.9%: 22.46).
+  double drift_translation_per_m = 0.03;
+  double drift_rotation_rad_per_m = 0.02;
+  double plausibility_chi2 = 22.46;
+  double loop_huber_delta = 2.8;  // whitened (sqrt chi-square); ~95% of a 6-dof inlier's chi
+  PoseGraphOptions graph;
+};
+
+struct LoopStats {
+  uint64_t keyframes = 0;  // records added
+  uint64_t queries = 0;
+  uint64_t consistent_candidates = 0;
+  uint64_t verifications = 0;
+  uint64_t loops_accepted = 0;
+  uint64_t rejected[kNumLoopRejections] = {};  // by LoopRejection (index 0 unused)
+  uint64_t culled = 0;
+  uint64_t edges_refined = 0;  // odometry edges replaced by final local-map poses
+  uint64_t optimisations = 0;
+  double optimisation_ms_total = 0;
+  double optimisation_ms_max = 0;
+  uint64_t loop_edges = 0;   // held now
+  uint64_t graph_nodes = 0;  // held now
+  uint64_t peak_graph_nodes = 0;
+};
+
+class LoopCloser {
+ public:
+  LoopCloser(const CameraIntrinsics& camera, const NoiseModelOptions& noise,
+             const LoopCloserOptions& options);
+  ~LoopCloser();
+  LoopCloser(const LoopCloser&) = delete;
+  LoopCloser& operator=(const LoopCloser&) = delete;
+
+  // Adds the record (copied) and runs detection; true when a loop was accepted and the graph
+  // optimised: correction() then holds the query keyframe's new pose.
+  bool addKeyframe(const LoopKeyframe& record);
+  const MapCorrection& correction() const { return correction_; }
+
+  // A keyframe's FINAL local-map pose and covariance (it left the local map), `epoch` = loop
+  // corrections the mapping side had applied then. When its graph predecessor is the keyframe
+  // before it in the map and got its final pose in the same epoch, the odometry edge between them
+  // is replaced by the relative of the two final poses (BA refined them many times since the
+  // records were made). Takes effect at the next optimisation (finalOptimise() at the end of a run).
+  void keyframeFinal(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam, const Matrix6d& covariance,
+                     bool covariance_valid, uint64_t epoch);
+  // End of a run: optimises once more if edges changed since the last optimisation (without any
+  // loop edge this simply re-chains the refined odometry).
+  void finalOptimise();
+
+  // The graph's current pose of a keyframe (optimised after a loop); false if not in the graph.
+  bool pose(uint32_t keyframe_id, Eigen::Isometry3d* T_world_cam) const;
+  std::size_t size() const { return order_.size(); }
+  std::size_t capacity() const { return std::size_t(options_.capacity); }
+  const LoopStats& stats() const { return stats_; }
+  const LoopCloserOptions& options() const { return options_; }
+  // Ids in the graph, ascending.
+  uint32_t idAt(std::size_t i) const { return nodes_[std::size_t(order_[i])].id; }
+  std::size_t memoryBytes() const;
+  static std::size_t memoryBytesFor(const LoopCloserOptions& options);
+
+ private:
+  struct Node {
+    uint32_t id = 0;
+    Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();  // graph estimate
+    bool has_edge = false;                                          // from the previous node in order_
+    Eigen::Isometry3d T_previous_this = Eigen::Isometry3d::Identity();
+    Matrix6d edge_covariance = Matrix6d::Identity();  // of this node, previous held fixed
+    double edge_length_m = 0;                         // distance travelled along the edge
+    uint32_t previous_map_id = 0;  // the record's previous keyframe in the map (0: none / segment)
+    bool has_final = false;        // keyframeFinal() seen
+    uint64_t final_epoch = 0;
+    Eigen::Isometry3d T_world_final = Eigen::Isometry3d::Identity();
+  };
+  struct LoopEdge {
+    uint32_t candidate_id = 0;
+    uint32_t query_id = 0;
+    Eigen::Isometry3d T_candidate_query = Eigen::Isometry3d::Identity();
+    Matrix6d information = Matrix6d::Identity();
+  };
+  struct Group {
+    uint32_t id = 0;
+    int count = 0;
+  };
+
+  int findPosition(uint32_t id) const;  // index into order_, -1 if absent
+  void addNode(const LoopKeyframe& record, int slot);
+  void cullOne();
+  void detect(int query_position);
+  bool plausible(int candidate_position, int query_position, const LoopMeasurement& m) const;
+  void optimise();
+  Matrix6d edgeCovariance(bool new_segment, const Matrix6d& covariance, bool covariance_valid) const;
+
+  LoopCloserOptions options_;
+  LoopVerifier verifier_;
+  KeyframeDatabase database_;
+  PoseGraph graph_;
+  std::unique_ptr<LoopKeyframe[]> records_;  // by slot
+  std::vector<Node> nodes_;                  // by slot
+  std::vector<int> free_slots_;
+  std::vector<int> order_;  // slots by ascending keyframe id
+  std::vector<LoopEdge> loop_edges_;
+  FixedVector<Group, kMaxPlaceCandidates> groups_, new_groups_;
+  PlaceCandidates candidates_;
+  int cooldown_ = 0;
+  bool edges_changed_ = false;  // since the last optimisation
+  MapCorrection correction_;
+  LoopStats stats_;
+};
+
+}  // namespace plumb::loop

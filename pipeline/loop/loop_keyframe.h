@@ -1,0 +1,86 @@
+#pragma once
+// LoopKeyframe: the compact, fixed-size record of one keyframe that loop closing keeps (docs/LOOP.md).
+// Made on the mapping side when a keyframe is inserted (makeLoopKeyframe, from the KeyframeRequest's
+// features and the mapper's poses), carried to the loop stage by value through an SPSC ring, and
+// stored by the LoopCloser. Nothing in it points anywhere: a plain value of fixed size.
+//
+//   points: the strongest kMaxLoopPoints keypoints WITH depth: ORB descriptor, 3D point in the camera
+//           frame, undistorted pixel, u_r and octave (what descriptor matching, 3D-3D RANSAC and the
+//           [u, v, u_r] refinement need);
+//   lines:  the first kMaxLoopLines lines with a 3D fit: LBD descriptor, normalised 2D line, octave
+//           and the line-guidance samples in the camera frame (the refinement's line errors);
+//   odometry: the pose of this keyframe relative to the previous keyframe of the map, taken from the
+//           mapper's poses right after this keyframe's local BA, and this keyframe's marginal
+//           covariance from that BA (the pose graph's odometry edge and its weight).
+// Size: sizeof(LoopKeyframe), ~43 KB (computed in tests/loop/loop_keyframe_test.cpp).
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+
+#include "pipeline/frontend/frame_features.h"
+#include "pipeline/odometry/keyframe_request.h"
+#include "platform/fixed_vector.h"
+#include "solver/types.h"
+
+namespace plumb {
+class LocalMapper;
+}
+
+namespace plumb::loop {
+
+constexpr std::size_t kMaxLoopPoints = 500;
+constexpr std::size_t kMaxLoopLines = 100;
+
+struct LoopPoint {
+  Eigen::Vector3f P_cam = Eigen::Vector3f::Zero();
+  Eigen::Vector2f px = Eigen::Vector2f::Zero();  // undistorted
+  float u_right = 0;
+  int8_t octave = 0;
+};
+
+struct LoopLine {
+  Eigen::Vector3f l = Eigen::Vector3f::Zero();  // normalised 2D line (undistorted pixels)
+  int8_t octave = 0;
+  uint8_t num_samples = 0;
+  std::array<Eigen::Vector3f, kMaxLineSamples> samples_cam{};
+};
+
+struct LoopKeyframe {
+  uint32_t id = 0;  // the map's keyframe id (grows forever)
+  uint64_t frame_sequence = 0;
+  double timestamp_s = 0;
+  // First keyframe of a map segment: no odometry edge from a previous keyframe of the same map
+  // (the closer links it to the previous record with a weak edge, see LoopCloserOptions).
+  bool new_segment = false;
+  uint32_t previous_id = 0;  // previous keyframe of the map (0: none)
+  Eigen::Isometry3d T_previous_this = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();  // mapping frame, at creation
+  Matrix6d covariance = Matrix6d::Zero();  // local BA marginal ([rho; phi], left on T_cam_world)
+  bool covariance_valid = false;
+
+  FixedVector<LoopPoint, kMaxLoopPoints> points;
+  FixedVector<Descriptor256, kMaxLoopPoints> point_descriptors;  // parallel to points
+  FixedVector<LoopLine, kMaxLoopLines> lines;
+  FixedVector<Descriptor256, kMaxLoopLines> line_descriptors;  // parallel to lines
+
+  void clearFeatures() {
+    points.clear();
+    point_descriptors.clear();
+    lines.clear();
+    line_descriptors.clear();
+  }
+};
+
+// The features of a record from a frame's features: the strongest keypoints with depth (response
+// descending, index ascending on ties: deterministic) and the first lines with a 3D fit (the front
+// end ranks lines best first). Allocation-free.
+void fillLoopFeatures(const FrameFeatures& features, LoopKeyframe* out);
+
+// The whole record for keyframe `keyframe_id`, just inserted by `mapper` from `request`: features,
+// and odometry from the mapper's current poses (the keyframe before it in the map, the covariance
+// of the local BA that ran at the insertion). Returns false when the keyframe is not in the map.
+bool makeLoopKeyframe(const KeyframeRequest& request, uint32_t keyframe_id, bool new_segment,
+                      const LocalMapper& mapper, LoopKeyframe* out);
+
+}  // namespace plumb::loop

@@ -1,0 +1,85 @@
+#pragma once
+// LoopVerifier: decides whether two LoopKeyframe records see the same place, and if so measures
+// their relative pose (docs/LOOP.md "Verification"):
+//   1. ORB matching query -> candidate: brute-force Hamming, absolute threshold + Lowe ratio;
+//   2. rigid 3D-3D RANSAC on the matched points (both have depth): rigid_ransac.h;
+//   3. refinement of T_query_candidate with the pose-only optimiser (solver/pose_optimizer.h):
+//      the candidate's 3D points against the query's [u, v, u_r] observations (RANSAC inliers),
+//      plus the candidate's line-guidance samples against the query's 2D lines for LBD matches;
+//      its covariance becomes the loop edge's information.
+// Each stage has a threshold (min matches, min inliers, min inlier ratio, min refined inliers).
+// Geometry cannot tell a true loop from repeated texture (identical modules ARE geometrically
+// consistent); the plausibility of the implied correction is judged by the LoopCloser, which knows
+// the odometry covariance between the two keyframes.
+// Scratch allocated at construction; verify() allocates nothing. Deterministic.
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <memory>
+
+#include "pipeline/loop/loop_keyframe.h"
+#include "pipeline/loop/rigid_ransac.h"
+#include "solver/camera_intrinsics.h"
+#include "solver/noise_model.h"
+#include "solver/types.h"
+
+namespace plumb::loop {
+
+struct LoopVerifierOptions {
+  int hamming_threshold = 50;       // ORB match acceptance (of 256 bits)
+  float ratio = 0.8f;               // Lowe ratio: best < ratio * second best
+  int line_hamming_threshold = 60;  // LBD
+  float line_ratio = 0.8f;
+  bool use_lines = true;  // line-guidance errors in the refinement
+  int min_matches = 40;
+  RigidRansacOptions ransac;
+  int min_inliers = 35;           // RANSAC inliers
+  double min_inlier_ratio = 0.3;  // RANSAC inliers / matches
+  int min_refined_inliers = 35;   // point inliers after refinement
+};
+
+enum class LoopRejection : uint8_t {
+  kNone = 0,
+  kFewMatches,
+  kFewInliers,
+  kLowInlierRatio,
+  kRefinement,   // refinement lost the inliers (or its covariance was degenerate)
+  kImplausible,  // LoopCloser: the implied correction is beyond the odometry uncertainty
+};
+constexpr int kNumLoopRejections = 6;
+const char* toString(LoopRejection r);
+
+struct LoopMeasurement {
+  LoopRejection rejection = LoopRejection::kFewMatches;
+  // Pose of the query camera in the candidate camera (maps query-camera points into the candidate's).
+  Eigen::Isometry3d T_candidate_query = Eigen::Isometry3d::Identity();
+  // Covariance of the query pose with the candidate held fixed (left perturbation of
+  // T_query_candidate, [rho; phi]): the pose graph's loop edge (candidate -> query) directly.
+  Matrix6d covariance = Matrix6d::Identity();
+  int matches = 0;
+  int ransac_inliers = 0;
+  int refined_inliers = 0;
+  int line_matches = 0;
+  int line_inliers = 0;
+  bool accepted() const { return rejection == LoopRejection::kNone; }
+};
+
+class LoopVerifier {
+ public:
+  LoopVerifier(const CameraIntrinsics& camera, const NoiseModelOptions& noise,
+               const LoopVerifierOptions& options);
+  ~LoopVerifier();
+  LoopVerifier(const LoopVerifier&) = delete;
+  LoopVerifier& operator=(const LoopVerifier&) = delete;
+
+  LoopMeasurement verify(const LoopKeyframe& query, const LoopKeyframe& candidate);
+  const LoopVerifierOptions& options() const { return options_; }
+
+ private:
+  struct Scratch;
+  CameraIntrinsics camera_;
+  NoiseModelOptions noise_;
+  LoopVerifierOptions options_;
+  std::unique_ptr<Scratch> s_;
+};
+
+}  // namespace plumb::loop

@@ -1,0 +1,190 @@
+// LoopCloser on chains of hand-made keyframe records: a drifted loop is closed and corrected, a
+// corridor of repeated modules yields no loop, capacity and culling keep everything bounded, and
+// adding keyframes allocates nothing.
+#include "pipeline/loop/loop_closer.h"
+
+#include <gtest/gtest.h>
+
+#include "platform/allocation_counter.h"
+#include "solver/se3.h"
+#include "tests/loop/loop_test_scenes.h"
+
+namespace plumb::test {
+namespace {
+
+loop::LoopCloser makeCloser(const loop::LoopCloserOptions& options) {
+  return loop::LoopCloser(intrinsicsOf(syntheticCamera()), NoiseModelOptions{}, options);
+}
+
+// Odometry that drifts: every measured step is the true one times a small yaw and forward error.
+Eigen::Isometry3d driftedStep(const Eigen::Isometry3d& true_step) {
+  Eigen::Isometry3d error = Eigen::Isometry3d::Identity();
+  error.linear() = Eigen::AngleAxisd(0.04 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  error.translation() = Eigen::Vector3d(0.0015, 0, 0.001);
+  return true_step * error;
+}
+
+TEST(LoopCloser, ClosesADriftedLoopAndCorrectsTheGraph) {
+  const Scene scene = cylinderScene(21, 6000, 3.5);
+  constexpr int kPerLap = 100, kTotal = 170;
+  auto pose_at = [&](int k) { return outwardPose(2 * M_PI * k / kPerLap, 1.0); };
+  loop::LoopCloser closer = makeCloser(loop::LoopCloserOptions{});
+  Eigen::Isometry3d T_odometry = pose_at(0);
+  int accepted_at = -1;
+  for (int k = 0; k < kTotal; ++k) {
+    Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+    if (k > 0) {
+      step = driftedStep(pose_at(k - 1).inverse() * pose_at(k));
+      T_odometry = T_odometry * step;
+    }
+    const auto record =
+        recordOf(scene, uint32_t(k + 1), pose_at(k), T_odometry, k > 0 ? uint32_t(k) : 0, step);
+    if (closer.addKeyframe(*record) && accepted_at < 0) {
+      accepted_at = k;
+      EXPECT_EQ(closer.correction().keyframe_id, uint32_t(k + 1));
+    }
+  }
+  // The first lap's end already overlaps its start (the field of view spans ~10 keyframes), and
+  // lap 2 revisits lap 1.
+  ASSERT_GE(accepted_at, kPerLap - 15);
+  EXPECT_LT(accepted_at, kPerLap + 10);
+  EXPECT_GE(closer.stats().loops_accepted, 2u);
+  EXPECT_EQ(closer.stats().rejected[int(loop::LoopRejection::kImplausible)], 0u);
+  // Drift of the odometry at the end against the graph after closing.
+  double odometry_error = 0, graph_error = 0, odometry_last = 0, graph_last = 0;
+  Eigen::Isometry3d T_chain = pose_at(0);
+  for (int k = 0; k < kTotal; ++k) {
+    if (k > 0) T_chain = T_chain * driftedStep(pose_at(k - 1).inverse() * pose_at(k));
+    Eigen::Isometry3d T_graph;
+    ASSERT_TRUE(closer.pose(uint32_t(k + 1), &T_graph));
+    odometry_error += translationError(T_chain, pose_at(k));
+    graph_error += translationError(T_graph, pose_at(k));
+    odometry_last = translationError(T_chain, pose_at(k));
+    graph_last = translationError(T_graph, pose_at(k));
+  }
+  odometry_error /= kTotal;
+  graph_error /= kTotal;
+  std::printf(
+      "keyframe position error, mean / last: odometry %.4f / %.4f m, after loop closing %.4f / %.4f m\n",
+      odometry_error, odometry_last, graph_error, graph_last);
+  EXPECT_GT(odometry_error, 0.05);
+  // The bias of every step stays in the odometry edges (the graph spreads, not removes, it): the
+  // mean halves, the end of the chain (pulled onto lap 1) improves most.
+  EXPECT_LT(graph_error, 0.5 * odometry_error);
+  EXPECT_LT(graph_last, 0.4 * odometry_last);
+  EXPECT_GE(closer.stats().optimisations, 1u);
+}
+
+// A corridor of identical 3 m modules along x (points on the wall y = 2 m, the same descriptors
+// in every module), walked one way with exact odometry: every module looks like the one before.
+TEST(LoopCloser, RejectsRepeatedTextureWithoutARealLoop) {
+  Scene module;
+  {
+    std::mt19937_64 rng(31);
+    std::uniform_real_distribution<double> x(0, 3), z(0.4, 2.6), response(10, 100);
+    for (int i = 0; i < 400; ++i) {
+      ScenePoint p;
+      p.P_world = Eigen::Vector3d(x(rng), 2.0, z(rng));
+      p.descriptor = randomDescriptor(rng);
+      p.response = float(response(rng));
+      module.points.push_back(p);
+    }
+  }
+  Scene corridor;
+  for (int m = 0; m < 7; ++m) {
+    for (ScenePoint p : module.points) {
+      p.P_world.x() += 3.0 * m;
+      corridor.points.push_back(p);
+    }
+  }
+  auto pose_at = [](int k) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear().col(0) = Eigen::Vector3d(1, 0, 0);
+    T.linear().col(1) = Eigen::Vector3d(0, 0, -1);
+    T.linear().col(2) = Eigen::Vector3d(0, 1, 0);
+    T.translation() = Eigen::Vector3d(1.5 + 0.075 * k, 0, 1.5);
+    return T;
+  };
+  loop::LoopCloser closer = makeCloser(loop::LoopCloserOptions{});
+  loop::LoopVerifier verifier(intrinsicsOf(syntheticCamera()), NoiseModelOptions{},
+                              loop::LoopVerifierOptions{});
+  const int kTotal = 200;  // 15 m: five modules
+  for (int k = 0; k < kTotal; ++k) {
+    const Eigen::Isometry3d step =
+        k > 0 ? pose_at(k - 1).inverse() * pose_at(k) : Eigen::Isometry3d::Identity();
+    const auto record =
+        recordOf(corridor, uint32_t(k + 1), pose_at(k), pose_at(k), k > 0 ? uint32_t(k) : 0, step);
+    EXPECT_FALSE(closer.addKeyframe(*record)) << "false loop at keyframe " << k;
+  }
+  EXPECT_EQ(closer.stats().loops_accepted, 0u);
+  // The views really are alike: the verifier alone accepts them (geometry cannot tell), the
+  // odometry covariance check is what refuses them.
+  EXPECT_GT(closer.stats().rejected[int(loop::LoopRejection::kImplausible)], 0u);
+  const auto a = recordOf(corridor, 1, pose_at(10), pose_at(10), 0, Eigen::Isometry3d::Identity());
+  const auto b = recordOf(corridor, 2, pose_at(50), pose_at(50), 0, Eigen::Isometry3d::Identity());
+  EXPECT_TRUE(verifier.verify(*b, *a).accepted());
+}
+
+// Records of unrelated views along a line; every third one sits between two 5 mm steps (redundant).
+std::vector<std::unique_ptr<loop::LoopKeyframe>> lineOfRecords(int n) {
+  std::vector<std::unique_ptr<loop::LoopKeyframe>> records;
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  for (int k = 0; k < n; ++k) {
+    Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+    if (k > 0) step.translation() = Eigen::Vector3d(k % 3 == 0 ? 0.1 : 0.005, 0, 0);
+    T = T * step;
+    auto r = std::make_unique<loop::LoopKeyframe>();
+    const View view = unrelatedView(1000 + uint64_t(k), 300);
+    loop::fillLoopFeatures(*view.features, r.get());
+    r->id = uint32_t(k + 1);
+    r->previous_id = k > 0 ? uint32_t(k) : 0;
+    r->T_previous_this = step;
+    r->T_world_cam = T;
+    records.push_back(std::move(r));
+  }
+  return records;
+}
+
+TEST(LoopCloser, CapacityCullsTheMostRedundantKeyframesAndStaysBounded) {
+  loop::LoopCloserOptions options;
+  options.capacity = 20;
+  loop::LoopCloser closer = makeCloser(options);
+  const auto records = lineOfRecords(60);
+  for (int k = 0; k < 60; ++k) {
+    (void)closer.addKeyframe(*records[std::size_t(k)]);
+    EXPECT_LE(closer.size(), 20u);
+    if (k == 29) {
+      // 10 culls so far, all of them keyframes between two 5 mm steps (id k + 1 with k % 3 == 1).
+      EXPECT_EQ(closer.stats().culled, 10u);
+      int redundant_culled = 0;
+      Eigen::Isometry3d T;
+      for (int j = 0; j < 29; ++j) {
+        if (!closer.pose(uint32_t(j + 1), &T)) redundant_culled += j % 3 == 1;
+      }
+      EXPECT_EQ(redundant_culled, 10);
+    }
+  }
+  EXPECT_EQ(closer.size(), 20u);
+  EXPECT_EQ(closer.stats().culled, 40u);
+  EXPECT_EQ(closer.stats().peak_graph_nodes, 20u);
+  Eigen::Isometry3d T;
+  EXPECT_TRUE(closer.pose(1, &T));   // the first (gauge) keyframe is never culled
+  EXPECT_TRUE(closer.pose(60, &T));  // nor the newest
+  EXPECT_NEAR(T.translation().x(), records.back()->T_world_cam.translation().x(), 1e-12);
+  EXPECT_GT(closer.memoryBytes(), 20 * sizeof(loop::LoopKeyframe));
+}
+
+TEST(LoopCloser, AddingKeyframesAllocatesNothing) {
+  loop::LoopCloserOptions options;
+  options.capacity = 20;
+  loop::LoopCloser closer = makeCloser(options);
+  const auto records = lineOfRecords(60);
+  const uint64_t before = allocationCount();
+  for (const auto& r : records) (void)closer.addKeyframe(*r);
+  EXPECT_EQ(allocationCount() - before, 0u);
+  EXPECT_EQ(closer.stats().culled, 40u);
+  EXPECT_GT(closer.stats().queries, 0u);
+}
+
+}  // namespace
+}  // namespace plumb::test
