@@ -22,3 +22,10 @@ if command -v clang++ >/dev/null 2>&1; then
 else
   echo "skipped: clang++ not found (scripts/install_deps.sh installs clang and libclang-rt-14-dev)"
 fi
+
+# aarch64 cross build and unit tests under qemu (docs/EMBEDDED.md): opt-in until its CI time is known
+# to fit (measured: ~9 min build plus ~15 min tests on a loaded 2-core machine).
+if [ "${PLUMB_CROSS:-0}" = "1" ]; then
+  echo "== aarch64 cross build, tests under qemu =="
+  bash scripts/cross_aarch64.sh
+fi
