@@ -53,7 +53,7 @@ LoopCloser::LoopCloser(const CameraIntrinsics& camera, const NoiseModelOptions& 
       verifier_(camera, noise, options.verifier),
       database_(databaseOptions(options)),
       graph_(options.capacity + 1, options.capacity + 1 + options.max_loop_edges),
-      records_(new LoopKeyframe[std::size_t(options.capacity + 1)]),
+      records_(std::size_t(options.capacity + 1)),
       nodes_(std::size_t(options.capacity + 1)) {
   // Odometry chain + loop edges: natural order, factor storage reserved here (no allocation by
   // operator new in later analyses).

@@ -30,6 +30,7 @@
 #include <memory>
 #include <vector>
 
+#include "solver/zero_page_allocator.h"
 #include "pipeline/loop/keyframe_database.h"
 #include "pipeline/loop/loop_keyframe.h"
 #include "pipeline/loop/loop_verifier.h"
@@ -156,7 +157,10 @@ class LoopCloser {
   LoopVerifier verifier_;
   KeyframeDatabase database_;
   PoseGraph graph_;
-  std::unique_ptr<LoopKeyframe[]> records_;  // by slot
+  // By slot. Reserved for the full capacity at start, but from zero pages (calloc): a slot costs
+  // resident memory only once a keyframe is stored in it (assigned whole before it is ever read),
+  // so a short run does not carry the capacity of an hour-long one.
+  std::vector<LoopKeyframe, ZeroPageAllocator<LoopKeyframe>> records_;
   std::vector<Node> nodes_;                  // by slot
   std::vector<int> free_slots_;
   std::vector<int> order_;  // slots by ascending keyframe id
