@@ -90,7 +90,10 @@ Status Odometry::create(const OdometryConfig& config, std::unique_ptr<Odometry>*
   if (!st.ok) return st;
   // A pose finishes output_delay frames after it was tracked; at finish() all of them at once.
   impl->finished = std::make_unique<FinishedQueue>(std::size_t(options.output_delay_frames) + 64);
-  impl->stepper = std::make_unique<OdometryStepper>(*impl->system, *impl->finished);
+  // Loop closing with the runner's default options, lock-step: the same bytes as `plumb run`.
+  const OdometryRunOptions run_defaults;
+  impl->stepper = std::make_unique<OdometryStepper>(*impl->system, *impl->finished,
+                                                    config.loop_closing ? &run_defaults.loop : nullptr);
   out->reset(new Odometry(std::move(impl)));
   return Status::Ok();
 }

@@ -77,6 +77,7 @@ struct OdometryConfig {
   bool lines = true;             // line features for tracking and mapping (false: points only)
   int line_samples = 5;          // line-guidance points per line: 0 or 2..10
   int output_delay_frames = 60;  // finished poses are held back this many frames for local BA
+  bool loop_closing = true;      // loop closing (docs/LOOP.md), as `plumb run`; false = `--no-loops`
 };
 
 enum class PixelFormat { kBgr, kRgb };

@@ -216,7 +216,7 @@ api::PixelFormat parseFormat(const std::string& format) {
 
 class PyOdometry {
  public:
-  PyOdometry(const py::object& camera, bool lines, int line_samples, int output_delay) {
+  PyOdometry(const py::object& camera, bool lines, int line_samples, int output_delay, bool loop_closing) {
     api::OdometryConfig config;
     if (py::isinstance<py::str>(camera)) {
       config.camera = api::CameraSpec::named(camera.cast<std::string>());
@@ -228,6 +228,7 @@ class PyOdometry {
     config.lines = lines;
     config.line_samples = line_samples;
     config.output_delay_frames = output_delay;
+    config.loop_closing = loop_closing;
     throwIfError(api::Odometry::create(config, &odometry_), true);
   }
 
@@ -332,8 +333,8 @@ PYBIND11_MODULE(plumb, m) {
       });
 
   py::class_<PyOdometry>(m, "Odometry", "Push-style odometry: one track() call per RGB-D frame")
-      .def(py::init<const py::object&, bool, int, int>(), py::arg("camera") = "tum1", py::arg("lines") = true,
-           py::arg("line_samples") = 5, py::arg("output_delay") = 60)
+      .def(py::init<const py::object&, bool, int, int, bool>(), py::arg("camera") = "tum1", py::arg("lines") = true,
+           py::arg("line_samples") = 5, py::arg("output_delay") = 60, py::arg("loop_closing") = true)
       .def("track", &PyOdometry::track, py::arg("rgb"), py::arg("depth"), py::arg("t"), py::arg("format") = "rgb",
            "rgb: uint8 HxWx3 (format 'rgb' or 'bgr'), depth: uint16 HxW raw units, t: seconds")
       .def("finished", &PyOdometry::finished, "Finished poses [(t, 4x4 or None)], oldest first, since the last call")

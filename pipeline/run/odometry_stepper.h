@@ -13,12 +13,15 @@
 //   stepper.finish();                         // every held-back pose reaches the sink
 //
 // After warm-up a step allocates nothing (as the runner's stages; tests/api checks it).
-// A loop-closing stage (pipeline/loop) joins the same way the runner adds it: one more process()
-// call after map_ in step(), over the same slot.
+// Loop closing: with loop options the stepper owns a LoopStage in its synchronous (lock-step) form
+// and hands it to the map stage exactly as the runner's deterministic mode does, so the stepper and
+// `plumb run` give the same bytes with loop closing on as off.
 #include <cstdint>
+#include <memory>
 
 #include "pipeline/odometry/mapper_fence.h"
 #include "pipeline/run/odometry_run.h"
+#include "pipeline/run/loop_stage.h"
 #include "pipeline/run/odometry_stages.h"
 #include "platform/status.h"
 
@@ -28,7 +31,9 @@ class OdometryStepper {
  public:
   // `system` and `sink` must outlive the stepper. Sets OpenCV to no worker threads, as the runner
   // does (process-wide): the stages are the parallelism and the output must not depend on a pool.
-  OdometryStepper(OdometrySystem& system, OdometrySink& sink);
+  // loop_options: nullptr = no loop closing; otherwise the loop stage runs lock-step.
+  OdometryStepper(OdometrySystem& system, OdometrySink& sink, const loop::LoopCloserOptions* loop_options = nullptr);
+  ~OdometryStepper();
 
   // The frame to fill before step(): write bgr (CV_8UC3, camera size), depth_raw (CV_16UC1) and
   // timestamp_s; sequence and the stamps are set by step().
@@ -49,6 +54,7 @@ class OdometryStepper {
   MapperFence fence_{false};  // lock-step: never waits
   ExtractStage extract_;
   TrackStage track_;
+  std::unique_ptr<LoopStage> loop_;  // before map_, which is given it
   MapStage map_;
   uint64_t frames_ = 0;
   bool finished_ = false;

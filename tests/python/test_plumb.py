@@ -133,8 +133,8 @@ def test_evaluate_equals_plumb_eval(plumb_binary, datasets_dir, tmp_path):
 # head250 from NumPy arrays vs `plumb run`: the module runs the runner's own stages lock-step, so
 # the trajectory files must be byte-identical, with the default output delay (60 frames, poses
 # refined by local BA) and with delay 0 (poses as tracked). PLUMB_PY_FRAMES sets how many frames
-# (default 100, 250 = the whole clip). The push API (Odometry.track) runs odometry without the
-# loop-closing stage (docs/API.md), so it is compared with `plumb run --no-loops`.
+# (default 100, 250 = the whole clip). Loop closing is on in both (the push API runs the loop stage
+# lock-step, as `plumb run`'s default mode); PLUMB_PY_FRAMES=250 includes head250's one loop.
 @pytest.mark.parametrize("delay", [60, 0])
 def test_head250_from_numpy_is_byte_identical_to_plumb_run(plumb_binary, datasets_dir, tmp_path, delay):
     folder = os.path.join(datasets_dir, "tum_fr1_rpy_head250")
@@ -143,7 +143,7 @@ def test_head250_from_numpy_is_byte_identical_to_plumb_run(plumb_binary, dataset
     frames = int(os.environ.get("PLUMB_PY_FRAMES", "100"))
     ref = tmp_path / "plumb_run.txt"
     subprocess.run([plumb_binary, "run", "--dataset", folder, "--max-frames", str(frames), "--out", str(ref),
-                    "--output-delay", str(delay), "--no-loops"], check=True, stdout=subprocess.DEVNULL)
+                    "--output-delay", str(delay)], check=True, stdout=subprocess.DEVNULL)
     reader = plumb.FrameReader(folder)
     odo = plumb.Odometry(camera=reader.camera, output_delay=delay)
     finished, tracked = [], []
