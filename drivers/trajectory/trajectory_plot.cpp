@@ -85,17 +85,32 @@ void drawAxes(cv::Mat& image, const Panel& p, const std::string& x_label, const 
   putText(image, y_label, {p.area.x, p.area.y - 8}, 0.5);
 }
 
-// Draws the curve through `points` (one per ATE sample), broken where the samples are more
-// than kGapS apart so that a stretch without estimates is not drawn as a straight jump.
-constexpr double kGapS = 0.5;
+// Draws the curve through `points` (one per ATE sample), broken where consecutive samples are
+// much further apart than usual, so that a stretch without estimates is not drawn as a straight
+// jump. "Usual" is the median spacing: a 30 Hz TUM sequence breaks at 0.5 s, ICL-NUIM's TUM-format
+// files (timestamps 1 s apart) at 5 s instead of at every sample. A lone sample is drawn as a dot.
+constexpr double kMinGapS = 0.5;
+double gapThreshold(const AteResult& ate) {
+  std::vector<double> spacing;
+  spacing.reserve(ate.samples.size());
+  for (std::size_t i = 1; i < ate.samples.size(); ++i)
+    spacing.push_back(ate.samples[i].timestamp_s - ate.samples[i - 1].timestamp_s);
+  if (spacing.empty()) return kMinGapS;
+  std::nth_element(spacing.begin(), spacing.begin() + spacing.size() / 2, spacing.end());
+  return std::max(kMinGapS, 5.0 * spacing[spacing.size() / 2]);
+}
+
 void drawPolyline(cv::Mat& image, const AteResult& ate, const std::vector<cv::Point>& points,
                   const cv::Scalar& colour, int thickness) {
+  const double gap_s = gapThreshold(ate);
   std::size_t start = 0;
   for (std::size_t i = 1; i <= points.size(); ++i) {
-    if (i < points.size() && ate.samples[i].timestamp_s - ate.samples[i - 1].timestamp_s <= kGapS) continue;
+    if (i < points.size() && ate.samples[i].timestamp_s - ate.samples[i - 1].timestamp_s <= gap_s) continue;
     if (i - start >= 2) {
       const std::vector<cv::Point> piece(points.begin() + start, points.begin() + i);
       cv::polylines(image, piece, false, colour, thickness, cv::LINE_AA);
+    } else if (i - start == 1) {
+      cv::circle(image, points[start], thickness + 1, colour, cv::FILLED, cv::LINE_AA);
     }
     start = i;
   }

@@ -1,5 +1,7 @@
 // `plumb eval` from the command line: the published answers, JSON output, the plot, and bad input
 // (non-zero exit and a message naming the file).
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -70,6 +72,43 @@ TEST(EvalCli, JsonIsValidWhenTheNumbersOverflow) {
   } else {
     EXPECT_FALSE(r.output.empty());  // refused with a message: also acceptable
   }
+}
+
+// Saturated-colour pixels: the trajectory curves (axes, grid and text are grey or black).
+int colouredPixels(const cv::Mat& image) {
+  int count = 0;
+  for (int r = 0; r < image.rows; ++r) {
+    for (int c = 0; c < image.cols; ++c) {
+      const cv::Vec3b p = image.at<cv::Vec3b>(r, c);
+      const int hi = std::max({p[0], p[1], p[2]}), lo = std::min({p[0], p[1], p[2]});
+      count += hi - lo > 80;
+    }
+  }
+  return count;
+}
+
+// ICL-NUIM's TUM-format files have timestamps 1 s apart: the curves must still be drawn (a fixed
+// 0.5 s gap rule once broke them at every sample and left empty axes).
+TEST(EvalCli, PlotDrawsCurvesForSamplesOneSecondApart) {
+  ScratchDir dir;
+  std::string gt, est;
+  for (int i = 0; i < 40; ++i) {
+    const double a = 0.15 * i;
+    char line[160];
+    std::snprintf(line, sizeof(line), "%d.0 %.4f %.4f 0 0 0 0 1\n", i, std::cos(a), std::sin(a));
+    gt += line;
+    std::snprintf(line, sizeof(line), "%d.0 %.4f %.4f 0.01 0 0 0 1\n", i, 1.02 * std::cos(a), std::sin(a));
+    est += line;
+  }
+  const std::string plot = dir.file("icl.png");
+  const RunResult r = runPlumb("eval --gt " + dir.write("gt.txt", gt) + " --est " + dir.write("est.txt", est) +
+                               " --plot " + plot);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const cv::Mat image = cv::imread(plot, cv::IMREAD_COLOR);
+  ASSERT_FALSE(image.empty());
+  const int coloured = colouredPixels(image);
+  std::printf("coloured pixels: %d\n", coloured);
+  EXPECT_GT(coloured, 5000) << "the trajectory curves are missing (old rule: 335 px, legend only)";
 }
 
 TEST(EvalCli, MissingFileExitsNonZeroNamingIt) {
