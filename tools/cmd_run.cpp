@@ -103,6 +103,10 @@ int runRun(int argc, char** argv) {
     printRunUsage();
     return 2;
   }
+  // From here on a stop request is honoured: one that arrives while the source and the system are
+  // being built ends the run before its first frame, cleanly (outputs written, exit code 3).
+  std::signal(SIGINT, onStopSignal);
+  std::signal(SIGTERM, onStopSignal);
   bool ok = true;
   const long line_samples = args.getInt("line-samples", 5, &ok);
   const long max_frames = args.getInt("max-frames", -1, &ok);
@@ -180,8 +184,6 @@ int runRun(int argc, char** argv) {
 
   RunOutputs outputs(output_options);
   RunRecord record;
-  std::signal(SIGINT, onStopSignal);
-  std::signal(SIGTERM, onStopSignal);
   st = runToOutputs(*source, system_options, run_options, outputs, &record);
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
