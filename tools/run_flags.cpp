@@ -14,9 +14,10 @@ const std::set<std::string>& scheduleSwitchFlags() {
 
 const char* scheduleUsage() {
   return "  --mode M             deterministic (default: the stages in lock-step on one thread, the\n"
-         "                       same bytes every run), fast (a thread per stage, no drops) or\n"
-         "                       realtime (threads, paced to the recorded timestamps, a frame finding\n"
-         "                       no free slot is dropped and counted)\n"
+         "                       same bytes every run), fast (a thread per stage, no drops, the\n"
+         "                       tracker waits for the map after each keyframe: the same bytes as\n"
+         "                       deterministic, faster) or realtime (threads, paced to the recorded\n"
+         "                       timestamps, a frame finding no free slot is dropped and counted)\n"
          "  --profile FILE       write a Chrome trace (Perfetto / chrome://tracing) and print\n"
          "                       p50/p90/p99/max per stage and end to end, drops, frames/s\n"
          "  --slots N            frame slots in flight in the threaded modes (default 8)\n"

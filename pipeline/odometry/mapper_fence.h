@@ -7,6 +7,13 @@
 // mapping thread is then idle until the current frame reaches it, so the two threads never touch
 // the mapper or the relocalizer at the same time. In lock-step (`threaded` false) that is always
 // already true and the fence never waits.
+//
+// It also carries the staleness bound of a threaded run, `max_frames_ahead`: how many frames the
+// tracker may track past a keyframe it asked for before it waits for the map stage to publish it
+// (OdometrySystem::trackFeatures). 0 = never: every keyframe decision and every frame is tracked
+// against exactly the map lock-step would have (fast mode: the deterministic bytes). The runner
+// chooses it per mode (pipeline/run/odometry_run.h, docs/RUNTIME.md "When the map stage falls
+// behind").
 #include <atomic>
 #include <cstdint>
 
@@ -16,7 +23,11 @@ namespace plumb {
 
 class MapperFence {
  public:
-  explicit MapperFence(bool threaded) : threaded_(threaded) {}
+  explicit MapperFence(bool threaded, int max_frames_ahead = 0)
+      : threaded_(threaded), max_frames_ahead_(max_frames_ahead) {}
+
+  bool threaded() const { return threaded_; }
+  int maxFramesAhead() const { return max_frames_ahead_; }
 
   // Tracking thread: while frame number framesTracked() is being tracked.
   void waitForMapper() {
@@ -38,6 +49,7 @@ class MapperFence {
 
  private:
   const bool threaded_;
+  const int max_frames_ahead_;
   uint64_t frames_tracked_ = 0;  // tracking thread only
   std::atomic<uint64_t> frames_mapped_{0};
   std::atomic<bool> failed_{false};

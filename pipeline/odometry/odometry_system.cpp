@@ -29,7 +29,6 @@ Status validate(const SystemOptions& options) {
                          ") exceeds line_samples (" + std::to_string(options.odometry.extractor.line_samples) +
                          "): no line could ever be fitted");
   }
-  if (options.max_frames_ahead_of_mapper < 0) return Status::Error("max_frames_ahead_of_mapper must be >= 0");
   if (options.output_delay_frames < 0 || options.output_delay_frames >= OdometryTrajectory::kMaxDelayFrames) {
     return Status::Error("output delay must be within 0.." + std::to_string(OdometryTrajectory::kMaxDelayFrames - 1) +
                          " frames");
@@ -132,12 +131,23 @@ void OdometrySystem::trackFeatures(const FrameFeatures& features, uint64_t seque
   // Read before installing: a request reported done has its snapshot published already.
   bool request_pending = keyframe_requests_done_.load(std::memory_order_acquire) < tracking_.keyframe_requests;
   // Bounded staleness (threaded runs on a starved CPU): the tracker runs at most
-  // max_frames_ahead_of_mapper frames past a keyframe it asked for before it waits for the mapper
-  // to publish it. Without the bound, a lagging map stage leaves tracking on an ever older map (no
-  // new keyframes while one is pending) and accuracy collapses under load. In lock-step a request
-  // is always done before the next frame, so this never waits there.
-  if (request_pending && fence != nullptr &&
-      ++tracking_.frames_since_request > options_.max_frames_ahead_of_mapper) {
+  // fence->maxFramesAhead() frames past a keyframe it asked for before it waits for the mapper to
+  // publish it (0 in fast mode: never, so it tracks against lock-step's map). Without the bound, a
+  // lagging map stage leaves tracking on an ever older map (no new keyframes while one is pending)
+  // and accuracy collapses under load. In lock-step a request is always done before the next
+  // frame, so this never waits there.
+  if (fence != nullptr && fence->threaded() && fence->maxFramesAhead() == 0) {
+    // Lock-step's map: a frame that asked for a keyframe is mapped completely (the keyframe, local
+    // BA and whatever loop closing did with it) before the next one is tracked. "Not pending" is
+    // not enough: the mapper reports the request done before its loop correction is applied.
+    if (tracking_.keyframe_requests > tracking_.keyframe_requests_synced) {
+      fence->waitForMapper();
+      ++tracking_.mapper_waits;
+      tracking_.keyframe_requests_synced = tracking_.keyframe_requests;
+      request_pending = false;
+    }
+  } else if (request_pending && fence != nullptr && fence->threaded() &&
+             ++tracking_.frames_since_request > fence->maxFramesAhead()) {
     fence->waitForMapper();
     ++tracking_.mapper_waits;
     request_pending = keyframe_requests_done_.load(std::memory_order_acquire) < tracking_.keyframe_requests;

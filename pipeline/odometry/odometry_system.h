@@ -16,10 +16,11 @@
 // events touch from the tracking side: starting a map (segment) and relocalizing wait on the
 // MapperFence (pipeline/odometry/mapper_fence.h) until every earlier frame has been mapped, so the
 // two threads never use the mapper or the relocalizer at the same time. In lock-step the fence
-// never waits and every frame sees exactly the single-threaded map; threaded runs track against
-// the newest snapshot published so far, and while a keyframe request is still with the mapper the
-// tracker makes no keyframe decision (ORB-SLAM's "local mapping busy"): it would judge against a
-// map that lacks the pending keyframe and ask for near-duplicates.
+// never waits and every frame sees exactly the single-threaded map. Threaded runs track against
+// the newest snapshot published so far, at most fence->maxFramesAhead() frames past a keyframe
+// they asked for (fast mode: 0, so they too see exactly the lock-step map), and while a keyframe
+// request is still with the mapper the tracker makes no keyframe decision (ORB-SLAM's "local
+// mapping busy"): it would judge against a map that lacks the pending keyframe.
 // Output: finished frames (reference-keyframe relative, see OdometryTrajectory) and retired
 // keyframes with their covariance, drained on the mapping side.
 #include <atomic>
@@ -73,9 +74,6 @@ struct SystemOptions {
   OdometryOptions odometry;
   // Output delay of the reference-keyframe-relative trajectory (frames); 0 = poses as tracked.
   int output_delay_frames = 60;
-  // Threaded runs: frames the tracker may run past a pending keyframe request before it waits for
-  // the map stage to publish that keyframe (bounded staleness under CPU load; docs/RUNTIME.md).
-  int max_frames_ahead_of_mapper = 4;
 };
 
 // Every option of the system in one place; validated once, where the system is built.
@@ -126,7 +124,7 @@ class OdometrySystem {
   // The mapper, read by the mapping side's own thread (loop records).
   const LocalMapper& mapper() const { return *mapping_.mapper; }
   const OdometryStats& stats() const { return mapping_.stats; }
-  // Tracking side: how often tracking waited for a lagging mapper (max_frames_ahead_of_mapper).
+  // Tracking side: how often tracking waited for a lagging mapper (MapperFence::maxFramesAhead).
   uint64_t mapperWaits() const { return tracking_.mapper_waits; }
   const MapperStats& mapperStats() const { return mapping_.mapper->stats(); }
   MapCounts mapCounts() const { return mapping_.mapper->map().counts(); }
@@ -143,6 +141,7 @@ class OdometrySystem {
     Eigen::Isometry3d T_world_last_good = Eigen::Isometry3d::Identity();
     uint64_t keyframe_requests = 0;  // handed to mapFrame()
     int frames_since_request = 0;    // frames tracked while the newest request was pending
+    uint64_t keyframe_requests_synced = 0;  // requests whose frame was fully mapped before tracking went on
     uint64_t mapper_waits = 0;       // times the bound above made tracking wait
   };
   // The mapping thread's state.

@@ -50,6 +50,9 @@ class LoopStage {
   // After finish() and the last retirements: the final optimisation (LoopCloser::finalOptimise).
   void finalOptimise() { closer_->finalOptimise(); }
 
+  // Records are processed on the caller's thread (lock-step and fast mode, and after finish()).
+  bool synchronous() const { return synchronous_; }
+
   // After finish():
   const loop::LoopStats& stats() const { return closer_->stats(); }
   uint64_t recordsDropped() const { return dropped_; }

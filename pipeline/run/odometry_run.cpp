@@ -17,6 +17,9 @@ Status validate(const OdometryRunOptions& options) {
   if (options.max_frames < -1 || options.max_frames == 0) {
     return Status::Error("max_frames must be a positive count (or -1: every frame)");
   }
+  if (options.max_frames_ahead_of_mapper < -1 || options.max_frames_ahead_of_mapper > 64) {
+    return Status::Error("max_frames_ahead_of_mapper must be within 0..64 (or -1: by mode)");
+  }
   return Status::Ok();
 }
 
@@ -55,17 +58,20 @@ Status runOdometry(FrameCapture& capture, OdometrySystem& system, OdometrySink& 
   schedule.end_to_end_stage = 2;
 
   DropLog drops;
-  MapperFence fence(!lock_step && !simulated);
+  const bool realtime = schedule.mode == runtime::RunMode::kRealtime;
+  int frames_ahead = options.max_frames_ahead_of_mapper;
+  if (frames_ahead < 0) frames_ahead = realtime ? OdometryRunOptions::kRealtimeFramesAhead : 0;
+  MapperFence fence(!lock_step && !simulated, frames_ahead);
   CaptureStage capture_stage(capture, options.max_frames, options.stop, drops);
   ExtractStage extract(system);
   TrackStage track(system, fence, sink);
   std::unique_ptr<LoopStage> loop;
   if (options.loop_closing) {
-    // Off the latency path like the map stage: nice 5 in real-time mode.
-    // Its own thread only where the stages have theirs (not lock-step, not the one-thread
-    // simulation of real time).
-    loop = std::make_unique<LoopStage>(system, options.loop, !lock_step && !simulated,
-                                       schedule.mode == runtime::RunMode::kRealtime ? 5 : 0);
+    // Its own thread only in real time (off the latency path like the map stage: nice 5), not in
+    // its one-thread simulation. Fast mode runs it on the map stage's thread, in lock-step with
+    // the map as in deterministic mode: a correction then reaches the same frame's map as there,
+    // which keeps fast mode's output the deterministic output.
+    loop = std::make_unique<LoopStage>(system, options.loop, realtime && !simulated, realtime ? 5 : 0);
     loop->start();
   }
   MapStage map(system, fence, drops, sink, options.warmup_frames, loop.get());

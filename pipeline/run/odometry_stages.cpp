@@ -105,6 +105,11 @@ Status MapStage::process(OdometrySlot& slot, const runtime::FrameStamps& stamps)
   if (loop_ != nullptr) loop_->keyframeInserted(*slot.tracked, out);
   const Status s = deliver(out);
   if (status.ok()) status = s;
+  // A loop closed in lock-step corrects the map before the next frame is tracked (a threaded loop
+  // stage's correction waits for the next mapFrame instead). After deliver(): the keyframes this
+  // frame retired carry poses from before the correction, so they go to the closer with the epoch
+  // of before it.
+  if (loop_ != nullptr && loop_->synchronous()) system_.applyLoopCorrection();
   // Process-wide count, read on this thread after each frame: from the first frame at or after
   // warm-up to the last one finished before the input ended, every thread's allocations are
   // included. The count is read before the flag, so a reading taken after a stage thread began

@@ -38,6 +38,7 @@ class CollectingSink final : public OdometrySink {
   CollectingSink(const OdometrySystem& system, bool keep_outputs, OdometryRun* run)
       : system_(system), keep_outputs_(keep_outputs), run_(run) {}
   Status onFrame(const FrameOutput& out) override {
+    if (on_frame) on_frame(out);
     if (keep_outputs_) run_->outputs.push_back(out);
     const MapCounts c = system_.mapCounts();
     run_->max_keyframes = std::max(run_->max_keyframes, c.keyframes);
@@ -55,6 +56,8 @@ class CollectingSink final : public OdometrySink {
     run_->references.emplace_back(f.reference_id, f.T_ref_cam);
     return Status::Ok();
   }
+  // Called first in onFrame(), on the map stage's thread (e.g. to make the map stage slow).
+  std::function<void(const FrameOutput&)> on_frame;
 
  private:
   const OdometrySystem& system_;
@@ -67,6 +70,8 @@ struct RunSettings {
   runtime::RunMode mode = runtime::RunMode::kDeterministic;
   bool keep_outputs = false;
   bool loop_closing = true;
+  int max_frames_ahead_of_mapper = -1;  // OdometryRunOptions: -1 = by mode
+  std::function<void(const FrameOutput&)> on_frame;  // CollectingSink::on_frame
 };
 
 inline OdometryRun runOdometry(FrameSource& source, const SystemOptions& options, const RunSettings& settings = {}) {
@@ -75,11 +80,13 @@ inline OdometryRun runOdometry(FrameSource& source, const SystemOptions& options
   run.status = OdometrySystem::create(source.camera(), options, &system);
   if (!run.status.ok()) return run;
   CollectingSink sink(*system, settings.keep_outputs, &run);
+  sink.on_frame = settings.on_frame;
   SourceCapture capture(source);
   OdometryRunOptions run_options;
   run_options.schedule.mode = settings.mode;
   run_options.max_frames = settings.max_frames;
   run_options.loop_closing = settings.loop_closing;
+  run_options.max_frames_ahead_of_mapper = settings.max_frames_ahead_of_mapper;
   run.status = runOdometry(capture, *system, sink, run_options, &run.result);
   run.optimized = run.trajectory;
   for (std::size_t i = 0; i < run.optimized.size(); ++i) {

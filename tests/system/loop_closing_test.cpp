@@ -5,7 +5,12 @@
 //     without loop closing;
 //   - synth:repeated at its full length (900 frames: identical corridor modules, no real loop):
 //     no loop accepted;
+//   - --mode fast with a map stage made slow on purpose: the same bytes as lock-step, loops and
+//     corrections included (the tracker never runs past a keyframe it asked for).
 #include <gtest/gtest.h>
+
+#include <chrono>
+#include <thread>
 
 #include "tests/support/odometry_run.h"
 
@@ -18,13 +23,27 @@ SynthOptions shortLoop() {
   return o;
 }
 
-OdometryRun runScene(const SynthOptions& options, bool loops, std::vector<StampedPose>* gt) {
+OdometryRun runScene(const SynthOptions& options, bool loops, std::vector<StampedPose>* gt,
+                     RunSettings settings = {}) {
   std::unique_ptr<SyntheticSource> source;
   EXPECT_TRUE(SyntheticSource::create(options, &source).ok());
   if (gt != nullptr) *gt = groundTruth(source->scene(), options.frames);
-  RunSettings settings;
   settings.loop_closing = loops;
   return runOdometry(*source, systemOptions(true), settings);
+}
+
+// Exactly equal, bit for bit (what the trajectory file's bytes depend on).
+::testing::AssertionResult sameTrajectory(const std::vector<StampedPose>& a, const std::vector<StampedPose>& b) {
+  if (a.size() != b.size()) return ::testing::AssertionFailure() << a.size() << " vs " << b.size() << " frames";
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a[i].timestamp != b[i].timestamp || a[i].valid != b[i].valid ||
+        !(a[i].T_world_cam.matrix().array() == b[i].T_world_cam.matrix().array()).all()) {
+      return ::testing::AssertionFailure() << "frame " << i << " differs: t " << a[i].timestamp << " position "
+                                           << a[i].T_world_cam.translation().transpose() << " vs "
+                                           << b[i].T_world_cam.translation().transpose();
+    }
+  }
+  return ::testing::AssertionSuccess();
 }
 
 TEST(LoopClosing, SynthLoopOptimisedAteAtMostHalfOfNoLoopClosing) {
@@ -58,6 +77,24 @@ TEST(LoopClosing, RepeatedCorridorAcceptsNoLoop) {
   EXPECT_GT(s.queries, 0u);
   EXPECT_EQ(s.loops_accepted, 0u);
   EXPECT_EQ(run.stats.loop_corrections_applied, 0u);
+}
+
+// A starved CPU, made reproducible: the map stage sleeps on every frame (twice as long on a
+// keyframe), so a threaded tracker that did not wait would track against an old map. Fast mode
+// must still write lock-step's bytes, loop corrections included.
+TEST(LoopClosing, FastModeWritesTheDeterministicBytesWhileTheMapStageLags) {
+  const OdometryRun lock_step = runScene(shortLoop(), true, nullptr);
+  RunSettings slow;
+  slow.mode = runtime::RunMode::kFast;
+  slow.on_frame = [](const FrameOutput& out) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(out.keyframe ? 6 : 3));
+  };
+  const OdometryRun fast = runScene(shortLoop(), true, nullptr, slow);
+  ASSERT_TRUE(lock_step.status.ok() && fast.status.ok());
+  ASSERT_GE(lock_step.stats.loop_corrections_applied, 1u) << "the scene must close a loop for this test";
+  EXPECT_EQ(fast.stats.loop_corrections_applied, lock_step.stats.loop_corrections_applied);
+  EXPECT_TRUE(sameTrajectory(fast.trajectory, lock_step.trajectory));
+  EXPECT_TRUE(sameTrajectory(fast.optimized, lock_step.optimized));
 }
 
 }  // namespace
