@@ -49,7 +49,8 @@ struct RunOptions {
   // Stages (bit s = processing stage s, 1..N) whose results are off the latency path (plumb: map)
   // run at nice background_nice (threaded modes), so that under CPU contention the kernel gives the
   // latency-path stages the core first; they still get the idle time. Lowering one's own priority
-  // needs no privilege. Ignored for a stage that also gets SCHED_FIFO.
+  // needs no privilege. With realtime_priority P > 1 they run SCHED_FIFO at P - 1 instead (below
+  // the latency path, above every normal process).
   uint32_t background_stages = 0;
   int background_nice = 10;
   // mlockall before the run (falls back with one warning).

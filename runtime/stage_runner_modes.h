@@ -29,9 +29,14 @@ void StageRunner<T>::applySettings(int s, const char* name) {
   settings.name = name;
   if (options_.pin_threads) settings.cpu = s % availableCpuCount();
   const bool background = s >= 1 && s < 32 && (options_.background_stages >> s & 1u) != 0;
-  settings.realtime_priority = background ? 0 : options_.realtime_priority;
+  // With real-time priority P, a background stage runs SCHED_FIFO one level below the latency
+  // path (P - 1): at normal priority it starved whenever other processes loaded the CPU (a soak on
+  // a loaded machine: the map stage fell behind, tracking waited for it, p99 ~250 ms, hundreds of
+  // drops), while one FIFO level below still yields to capture, extract and track.
+  const int background_priority = options_.realtime_priority > 1 ? options_.realtime_priority - 1 : 0;
+  settings.realtime_priority = background ? background_priority : options_.realtime_priority;
   (void)applyThreadSettings(settings);  // failures are warned about once and fall back
-  if (background) (void)setCurrentThreadNice(options_.background_nice);
+  if (background && settings.realtime_priority == 0) (void)setCurrentThreadNice(options_.background_nice);
 }
 
 template <typename T>

@@ -2,7 +2,9 @@
 # Quick start 2: install what is missing, build, run every test:
 #   1. the Release build and its whole ctest suite;
 #   2. platform/ and runtime/ tests again under ThreadSanitizer (lock-free code);
-#   3. every parser's libFuzzer target for 20 s each (scripts/fuzz.sh; skipped without clang).
+#   3. AddressSanitizer + UBSan (-O1, scripts/sanitize.sh's asan-fast preset): every test binary
+#      except the system area's long replays (`bash scripts/sanitize.sh` runs all of them);
+#   4. every parser's libFuzzer target for 20 s each (scripts/fuzz.sh; skipped without clang).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 JOBS=$(nproc 2>/dev/null || echo 2)
@@ -15,6 +17,10 @@ cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPLUMB_TSAN_ONLY=ON 
   -DPLUMB_SANITIZE=thread >/dev/null
 cmake --build build-tsan -j "$JOBS"
 TSAN_OPTIONS="halt_on_error=1" ctest --test-dir build-tsan --output-on-failure -j "$JOBS" --timeout 600
+
+echo "== AddressSanitizer + UBSan: every area but system (scripts/sanitize.sh) =="
+PRESET=asan-fast bash scripts/sanitize.sh platform runtime solver pipeline odometry loop drivers devices \
+  mavlink api tools
 
 echo "== Fuzzing: every parser, 20 s each (scripts/fuzz.sh) =="
 if command -v clang++ >/dev/null 2>&1; then
