@@ -34,7 +34,7 @@ int clipToNearPlane(const Eigen::Vector3d* in, int count, Eigen::Vector3d* out) 
 }  // namespace
 
 FrameRenderer::FrameRenderer(const SceneModel& model, const PinholeCamera& camera)
-    : model_(model), camera_(camera) {
+    : model_(model), camera_(camera), textures_(model) {
   quads_cam_.resize(model.quads.size());
   ray_x_.resize(camera.width);
   ray_y_.resize(camera.height);
@@ -51,8 +51,10 @@ void FrameRenderer::render(const Eigen::Isometry3d& T_world_cam) {
   float* depth = depth_m_.ptr<float>();
   std::fill(depth, depth + depth_m_.total(), std::numeric_limits<float>::infinity());
   std::fill(quad_id_.begin(), quad_id_.end(), -1);
+  // Shading samples only quads whose id is in the z-buffer (pixel centres, and the 3x3
+  // neighbourhoods supersampled at edges), all of which won a pixel while rasterising.
   for (int q = 0; q < static_cast<int>(quads_cam_.size()); ++q)
-    if (quads_cam_[q].facing) rasteriseQuad(q);
+    if (quads_cam_[q].facing && rasteriseQuad(q)) textures_.prepare(q);
   shadePixels();
 }
 
@@ -71,7 +73,7 @@ void FrameRenderer::transformQuads(const Eigen::Isometry3d& T_world_cam) {
   }
 }
 
-void FrameRenderer::rasteriseQuad(int quad_index) {
+bool FrameRenderer::rasteriseQuad(int quad_index) {
   const SceneQuad& quad = model_.quads[quad_index];
   const QuadInCamera& qc = quads_cam_[quad_index];
   const Eigen::Vector3d corners[4] = {qc.origin, qc.origin + qc.axis_u * quad.length_u,
@@ -79,7 +81,8 @@ void FrameRenderer::rasteriseQuad(int quad_index) {
                                       qc.origin + qc.axis_v * quad.length_v};
   Eigen::Vector3d clipped[8];
   const int count = clipToNearPlane(corners, 4, clipped);
-  if (count < 3) return;
+  if (count < 3) return false;
+  bool won_a_pixel = false;
   double px[8], py[8];
   double y_min = std::numeric_limits<double>::infinity(), y_max = -y_min;
   for (int i = 0; i < count; ++i) {
@@ -121,9 +124,11 @@ void FrameRenderer::rasteriseQuad(int quad_index) {
       if (z < depth_row[x]) {
         depth_row[x] = static_cast<float>(z);
         id_row[x] = quad_index;
+        won_a_pixel = true;
       }
     }
   }
+  return won_a_pixel;
 }
 
 int FrameRenderer::castRay(double u, double v, const int* candidates, int count, double* z) const {
@@ -166,8 +171,7 @@ cv::Vec3f FrameRenderer::shadePoint(int quad_index, const Eigen::Vector3d& P_cam
   // Lighting is baked into the texture (light_baking.h): shading is one bilinear lookup.
   const QuadInCamera& qc = quads_cam_[quad_index];
   const Eigen::Vector3d offset = P_cam - qc.origin;
-  return sampleTexture(model_.textures[model_.quads[quad_index].texture], offset.dot(qc.axis_u),
-                       offset.dot(qc.axis_v));
+  return sampleTexture(textures_.texture(quad_index), offset.dot(qc.axis_u), offset.dot(qc.axis_v));
 }
 
 void FrameRenderer::shadePixels() {
