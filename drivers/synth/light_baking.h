@@ -15,7 +15,12 @@ namespace plumb::synth {
 // lightmap_texels_per_metre. Afterwards every quad has a texture.
 void planLightMaps(SceneModel& model, double lightmap_texels_per_metre);
 
-// Multiplies the light on `quad` into bgr, its painted texture at texels_per_metre.
+// Multiplies the light on `quad` into bgr, its painted texture at texels_per_metre. Axis-aligned
+// quads (u and v along +world axes, as addBox makes them all) take a separable fast path with
+// the same result to the bit; any other quad takes bakeLightingPerTexel.
 void bakeLighting(const SceneModel& model, const SceneQuad& quad, double texels_per_metre, cv::Mat& bgr);
+
+// The formula above evaluated texel by texel, for any quad (the oracle of the fast path).
+void bakeLightingPerTexel(const SceneModel& model, const SceneQuad& quad, double texels_per_metre, cv::Mat& bgr);
 
 }  // namespace plumb::synth
