@@ -35,6 +35,7 @@ class BakedTextures {
  private:
   const SceneModel& model_;
   std::vector<SurfaceTexture> textures_;  // indexed like model.textures
+  PaintScratch scratch_;
 };
 
 }  // namespace plumb::synth

@@ -51,7 +51,8 @@ double texelCentre(int i, double texels_per_metre, double length) {
 }
 
 // light = float(base + lamp_strength * (facing / sqrt(d2)) / (1 + d2 / 4)),
-// d2 = (column_term + row_first) + row_second.
+// d2 = (column_term + row_first) + row_second. d2 * 0.25 is d2 / 4 to the bit (a power of two),
+// one division fewer.
 struct TexelLight {
   double base, lamp_strength, facing;
   double row_first = 0, row_second = 0;
@@ -59,7 +60,7 @@ struct TexelLight {
   float at(double column_term) const {
     const double distance2 = (column_term + row_first) + row_second;
     const double cosine = facing / std::sqrt(distance2);
-    return static_cast<float>(base + lamp_strength * cosine / (1.0 + distance2 / 4.0));
+    return static_cast<float>(base + lamp_strength * cosine / (1.0 + distance2 * 0.25));
   }
 #if CV_SIMD128_64F
   cv::v_float64x2 at(const cv::v_float64x2& column_term) const {
@@ -67,7 +68,7 @@ struct TexelLight {
     const cv::v_float64x2 distance2 = (column_term + v_setall_f64(row_first)) + v_setall_f64(row_second);
     const cv::v_float64x2 cosine = v_setall_f64(facing) / cv::v_sqrt(distance2);
     return v_setall_f64(base) +
-           v_setall_f64(lamp_strength) * cosine / (v_setall_f64(1.0) + distance2 / v_setall_f64(4.0));
+           v_setall_f64(lamp_strength) * cosine / (v_setall_f64(1.0) + distance2 * v_setall_f64(0.25));
   }
 #endif
 

@@ -106,24 +106,51 @@ void replay(const PaintOp& op, cv::Mat& bgr) {
 }
 
 // Multiplies the texture by the smoothly upsampled coarse gains (stains, uneven paint).
-void applyShading(const TextureRecipe& recipe, cv::Mat& bgr) {
+void reserve(cv::Mat& buffer, int rows, int cols, int type) {
+  const size_t bytes = static_cast<size_t>(rows) * cols * CV_ELEM_SIZE(type);
+  if (buffer.total() < bytes) buffer.create(1, static_cast<int>(bytes), CV_8U);
+}
+
+// A rows x cols view of `buffer`, grown (never shrunk) to hold it.
+cv::Mat viewOf(cv::Mat& buffer, int rows, int cols, int type) {
+  reserve(buffer, rows, cols, type);
+  return cv::Mat(rows, cols, type, buffer.data);
+}
+
+cv::Size shadingGainSize(const TextureRecipe& recipe) {
+  return cv::Size(recipe.shading_gain_coarse.cols * recipe.shading_cell,
+                  recipe.shading_gain_coarse.rows * recipe.shading_cell);
+}
+
+void applyShading(const TextureRecipe& recipe, cv::Mat& gain_buffer, cv::Mat& bgr) {
   const cv::Mat& coarse = recipe.shading_gain_coarse;
-  const int cell = recipe.shading_cell;
-  cv::Mat gain;
-  cv::resize(coarse, gain, cv::Size(coarse.cols * cell, coarse.rows * cell), 0, 0, cv::INTER_CUBIC);
+  const cv::Size size = shadingGainSize(recipe);
+  cv::Mat gain = viewOf(gain_buffer, size.height, size.width, CV_32F);
+  cv::resize(coarse, gain, gain.size(), 0, 0, cv::INTER_CUBIC);  // fills the view in place
   for (int r = 0; r < bgr.rows; ++r) multiplyTexels(bgr.ptr<cv::Vec3b>(r), gain.ptr<float>(r), bgr.cols);
 }
 
 }  // namespace
 
-void paintTexture(const TextureRecipe& recipe, cv::Mat& bgr) {
+void PaintScratch::reserveFor(const TextureRecipe& recipe) {
+  if (recipe.shading_gain_coarse.empty()) return;  // flat light maps use no scratch
+  reserve(canvas, recipe.rows, recipe.cols, CV_8UC3);
+  const cv::Size size = shadingGainSize(recipe);
+  reserve(gain, size.height, size.width, CV_32F);
+}
+
+void paintTexture(const TextureRecipe& recipe, PaintScratch& scratch, cv::Mat& bgr) {
+  const bool procedural = !recipe.shading_gain_coarse.empty();
+  // Procedural textures are drawn in the scratch canvas and blurred into bgr; a flat light map
+  // is just its colour.
   bgr.create(recipe.rows, recipe.cols, CV_8UC3);
-  bgr.setTo(recipe.base_bgr);
-  for (const PaintOp& op : recipe.ops) replay(op, bgr);
-  if (recipe.shading_gain_coarse.empty()) return;  // a flat light map
-  applyShading(recipe, bgr);
+  cv::Mat canvas = procedural ? viewOf(scratch.canvas, recipe.rows, recipe.cols, CV_8UC3) : bgr;
+  canvas.setTo(recipe.base_bgr);
+  for (const PaintOp& op : recipe.ops) replay(op, canvas);
+  if (!procedural) return;
+  applyShading(recipe, scratch.gain, canvas);
   // Band-limit: no detail finer than ~2 texels, so distant views do not alias.
-  cv::GaussianBlur(bgr, bgr, cv::Size(0, 0), 0.7);
+  cv::GaussianBlur(canvas, bgr, cv::Size(0, 0), 0.7);
 }
 
 }  // namespace plumb::synth

@@ -4,7 +4,7 @@
 // drawing, shading, blur) costs millions of instructions for a wall, so the scenes record every
 // recipe when they are built (the draws come from one sequential generator, whose order must not
 // depend on which faces a frame sees) and paint a face only when a frame first sees it
-// (baked_textures.h). paintTexture replays the operations in order on a fresh image, so a recipe
+// (baked_textures.h). paintTexture replays the operations in order on a blank image, so a recipe
 // gives the same texels as drawing straight away did.
 #include <vector>
 
@@ -72,7 +72,17 @@ struct TextureRecipe {
 // A recipe of a plain face, width_m x height_m at texels_per_metre, in one colour.
 TextureRecipe flatTextureRecipe(double width_m, double height_m, double texels_per_metre, const cv::Vec3f& bgr);
 
+// Buffers that painting reuses from texture to texture (they grow to the largest), so that
+// painting a scene does not touch fresh memory, page fault after page fault, for every face.
+struct PaintScratch {
+  // Grows the buffers to what painting `recipe` needs (untouched memory costs nothing until used).
+  void reserveFor(const TextureRecipe& recipe);
+
+  cv::Mat canvas;  // the texture before its blur
+  cv::Mat gain;    // the upsampled shading gains
+};
+
 // Paints the recipe into bgr (CV_8UC3, reallocated to rows x cols).
-void paintTexture(const TextureRecipe& recipe, cv::Mat& bgr);
+void paintTexture(const TextureRecipe& recipe, PaintScratch& scratch, cv::Mat& bgr);
 
 }  // namespace plumb::synth
