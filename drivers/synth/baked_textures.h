@@ -11,6 +11,7 @@
 #include <opencv2/core.hpp>
 
 #include "drivers/synth/scene_model.h"
+#include "platform/huge_page_buffer.h"
 
 namespace plumb::synth {
 
@@ -22,7 +23,8 @@ struct SurfaceTexture {
 
 class BakedTextures {
  public:
-  // Keeps a reference to model (it must outlive this); paints nothing yet.
+  // Keeps a reference to model (it must outlive this); reserves memory for every texture but
+  // paints nothing yet.
   explicit BakedTextures(const SceneModel& model);
 
   // Paints and lights quad_index's texture unless that is done already.
@@ -35,6 +37,10 @@ class BakedTextures {
  private:
   const SceneModel& model_;
   std::vector<SurfaceTexture> textures_;  // indexed like model.textures
+  // One block for every texture and the painting scratch, sized at construction: textures are
+  // handed out from it as they are painted (huge pages: few page faults; see huge_page_buffer.h).
+  HugePageBuffer memory_;
+  size_t memory_used_ = 0;
   PaintScratch scratch_;
 };
 

@@ -40,9 +40,19 @@ FrameRenderer::FrameRenderer(const SceneModel& model, const PinholeCamera& camer
   ray_y_.resize(camera.height);
   for (int x = 0; x < camera.width; ++x) ray_x_[x] = (x - camera.cx) / camera.fx;
   for (int y = 0; y < camera.height; ++y) ray_y_[y] = (y - camera.cy) / camera.fy;
-  quad_id_.resize(static_cast<size_t>(camera.width) * camera.height);
-  colour_bgr_.create(camera.height, camera.width, CV_32FC3);
-  depth_m_.create(camera.height, camera.width, CV_32FC1);
+  // Colour, depth and quad ids in one huge-page block (few page faults on the first frame).
+  const size_t pixels = static_cast<size_t>(camera.width) * camera.height;
+  buffers_ = HugePageBuffer(pixels * (sizeof(cv::Vec3f) + sizeof(float) + sizeof(int32_t)));
+  if (buffers_.data()) {
+    colour_bgr_ = cv::Mat(camera.height, camera.width, CV_32FC3, buffers_.data());
+    depth_m_ = cv::Mat(camera.height, camera.width, CV_32FC1, buffers_.data() + pixels * sizeof(cv::Vec3f));
+    quad_id_ = reinterpret_cast<int32_t*>(buffers_.data() + pixels * (sizeof(cv::Vec3f) + sizeof(float)));
+  } else {
+    colour_bgr_.create(camera.height, camera.width, CV_32FC3);
+    depth_m_.create(camera.height, camera.width, CV_32FC1);
+    fallback_quad_id_.resize(pixels);
+    quad_id_ = fallback_quad_id_.data();
+  }
 }
 
 void FrameRenderer::render(const Eigen::Isometry3d& T_world_cam) {
@@ -50,7 +60,7 @@ void FrameRenderer::render(const Eigen::Isometry3d& T_world_cam) {
   // Plain fill: cv::Mat::setTo allocates a scratch buffer on every call.
   float* depth = depth_m_.ptr<float>();
   std::fill(depth, depth + depth_m_.total(), std::numeric_limits<float>::infinity());
-  std::fill(quad_id_.begin(), quad_id_.end(), -1);
+  std::fill(quad_id_, quad_id_ + depth_m_.total(), -1);
   // Shading samples only quads whose id is in the z-buffer (pixel centres, and the 3x3
   // neighbourhoods supersampled at edges), all of which won a pixel while rasterising.
   for (int q = 0; q < static_cast<int>(quads_cam_.size()); ++q)
@@ -115,7 +125,7 @@ bool FrameRenderer::rasteriseQuad(int quad_index) {
     const int col_end = std::min(width - 1, static_cast<int>(std::floor(x_right + kSpanSlackPx)));
     if (col_begin > col_end) continue;
     float* depth_row = depth_m_.ptr<float>(y);
-    int32_t* id_row = quad_id_.data() + static_cast<size_t>(y) * width;
+    int32_t* id_row = quad_id_ + static_cast<size_t>(y) * width;
     const double row_term = qc.normal.y() * ray_y_[y] + qc.normal.z();
     for (int x = col_begin; x <= col_end; ++x) {
       const double denominator = qc.normal.x() * ray_x_[x] + row_term;  // n . r, r = (rx, ry, 1)
@@ -179,7 +189,7 @@ void FrameRenderer::shadePixels() {
   edge_pixels_ = 0;
   for (int y = 0; y < height; ++y) {
     const float* depth_row = depth_m_.ptr<float>(y);
-    const int32_t* id_row = quad_id_.data() + static_cast<size_t>(y) * width;
+    const int32_t* id_row = quad_id_ + static_cast<size_t>(y) * width;
     cv::Vec3f* colour_row = colour_bgr_.ptr<cv::Vec3f>(y);
     for (int x = 0; x < width; ++x) {
       const int id = id_row[x];

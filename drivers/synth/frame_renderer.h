@@ -23,6 +23,7 @@
 
 #include "drivers/synth/baked_textures.h"
 #include "drivers/synth/scene_model.h"
+#include "platform/huge_page_buffer.h"
 #include "sensor/camera.h"
 
 namespace plumb::synth {
@@ -63,8 +64,10 @@ class FrameRenderer {
   BakedTextures textures_;
   std::vector<QuadInCamera> quads_cam_;
   std::vector<double> ray_x_, ray_y_;  // (u - cx) / fx per column, (v - cy) / fy per row
-  std::vector<int32_t> quad_id_;       // per pixel, -1 = nothing
+  HugePageBuffer buffers_;             // holds the three below
+  int32_t* quad_id_ = nullptr;         // per pixel, -1 = nothing
   cv::Mat colour_bgr_, depth_m_;
+  std::vector<int32_t> fallback_quad_id_;  // quad_id_'s memory if buffers_ could not be had
   int edge_pixels_ = 0;
 };
 

@@ -106,14 +106,10 @@ void replay(const PaintOp& op, cv::Mat& bgr) {
 }
 
 // Multiplies the texture by the smoothly upsampled coarse gains (stains, uneven paint).
-void reserve(cv::Mat& buffer, int rows, int cols, int type) {
-  const size_t bytes = static_cast<size_t>(rows) * cols * CV_ELEM_SIZE(type);
-  if (buffer.total() < bytes) buffer.create(1, static_cast<int>(bytes), CV_8U);
-}
-
 // A rows x cols view of `buffer`, grown (never shrunk) to hold it.
 cv::Mat viewOf(cv::Mat& buffer, int rows, int cols, int type) {
-  reserve(buffer, rows, cols, type);
+  const size_t bytes = static_cast<size_t>(rows) * cols * CV_ELEM_SIZE(type);
+  if (buffer.total() < bytes) buffer.create(1, static_cast<int>(bytes), CV_8U);
   return cv::Mat(rows, cols, type, buffer.data);
 }
 
@@ -132,11 +128,14 @@ void applyShading(const TextureRecipe& recipe, cv::Mat& gain_buffer, cv::Mat& bg
 
 }  // namespace
 
-void PaintScratch::reserveFor(const TextureRecipe& recipe) {
-  if (recipe.shading_gain_coarse.empty()) return;  // flat light maps use no scratch
-  reserve(canvas, recipe.rows, recipe.cols, CV_8UC3);
-  const cv::Size size = shadingGainSize(recipe);
-  reserve(gain, size.height, size.width, CV_32F);
+size_t PaintScratch::canvasBytes(const TextureRecipe& recipe) {
+  if (recipe.shading_gain_coarse.empty()) return 0;  // flat light maps use no scratch
+  return static_cast<size_t>(recipe.rows) * recipe.cols * 3;
+}
+
+size_t PaintScratch::gainBytes(const TextureRecipe& recipe) {
+  if (recipe.shading_gain_coarse.empty()) return 0;
+  return static_cast<size_t>(shadingGainSize(recipe).area()) * sizeof(float);
 }
 
 void paintTexture(const TextureRecipe& recipe, PaintScratch& scratch, cv::Mat& bgr) {

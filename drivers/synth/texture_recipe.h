@@ -75,14 +75,15 @@ TextureRecipe flatTextureRecipe(double width_m, double height_m, double texels_p
 // Buffers that painting reuses from texture to texture (they grow to the largest), so that
 // painting a scene does not touch fresh memory, page fault after page fault, for every face.
 struct PaintScratch {
-  // Grows the buffers to what painting `recipe` needs (untouched memory costs nothing until used).
-  void reserveFor(const TextureRecipe& recipe);
+  // Bytes of each buffer that painting `recipe` needs (0 for a flat light map).
+  static size_t canvasBytes(const TextureRecipe& recipe);
+  static size_t gainBytes(const TextureRecipe& recipe);
 
-  cv::Mat canvas;  // the texture before its blur
-  cv::Mat gain;    // the upsampled shading gains
+  cv::Mat canvas;  // the texture before its blur (bytes, one row)
+  cv::Mat gain;    // the upsampled shading gains (bytes, one row)
 };
 
-// Paints the recipe into bgr (CV_8UC3, reallocated to rows x cols).
+// Paints the recipe into bgr (CV_8UC3; reallocated unless it is rows x cols already).
 void paintTexture(const TextureRecipe& recipe, PaintScratch& scratch, cv::Mat& bgr);
 
 }  // namespace plumb::synth
