@@ -163,7 +163,7 @@ int FrameRenderer::castRay(double u, double v, const int* candidates, int count,
   return best;
 }
 
-cv::Vec3f FrameRenderer::sampleTexture(const SurfaceTexture& texture, double s_m, double t_m) const {
+inline cv::Vec3f FrameRenderer::sampleTexture(const SurfaceTexture& texture, double s_m, double t_m) const {
   const cv::Mat& bgr = texture.bgr;
   const float x = std::clamp(static_cast<float>(s_m * texture.texels_per_metre) - 0.5f, 0.0f, bgr.cols - 1.001f);
   const float y = std::clamp(static_cast<float>(t_m * texture.texels_per_metre) - 0.5f, 0.0f, bgr.rows - 1.001f);
@@ -177,7 +177,7 @@ cv::Vec3f FrameRenderer::sampleTexture(const SurfaceTexture& texture, double s_m
                    w00 * p00[2] + w01 * p00[5] + w10 * p10[2] + w11 * p10[5]);
 }
 
-cv::Vec3f FrameRenderer::shadePoint(int quad_index, const Eigen::Vector3d& P_cam) const {
+inline cv::Vec3f FrameRenderer::shadePoint(int quad_index, const Eigen::Vector3d& P_cam) const {
   // Lighting is baked into the texture (light_baking.h): shading is one bilinear lookup.
   const QuadInCamera& qc = quads_cam_[quad_index];
   const Eigen::Vector3d offset = P_cam - qc.origin;
