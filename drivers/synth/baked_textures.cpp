@@ -23,6 +23,7 @@ BakedTextures::BakedTextures(const SceneModel& model) : model_(model), textures_
     canvas_bytes = std::max(canvas_bytes, aligned(PaintScratch::canvasBytes(recipe)));
     gain_bytes = std::max(gain_bytes, aligned(PaintScratch::gainBytes(recipe)));
     texture_bytes += textureBytes(recipe);
+    light_scratch_.reserve(recipe.cols);
   }
   memory_ = HugePageBuffer(canvas_bytes + gain_bytes + texture_bytes);
   if (!memory_.data()) return;  // no block: painting allocates as it goes
@@ -41,7 +42,7 @@ void BakedTextures::prepare(int quad_index) {
     memory_used_ += textureBytes(recipe);
   }
   paintTexture(recipe, scratch_, texture.bgr);
-  bakeLighting(model_, quad, recipe.texels_per_metre, texture.bgr);
+  bakeLighting(model_, quad, recipe.texels_per_metre, texture.bgr, light_scratch_);
   texture.texels_per_metre = recipe.texels_per_metre;
 }
 

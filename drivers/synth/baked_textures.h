@@ -10,6 +10,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "drivers/synth/light_baking.h"
 #include "drivers/synth/scene_model.h"
 #include "platform/huge_page_buffer.h"
 
@@ -42,6 +43,7 @@ class BakedTextures {
   HugePageBuffer memory_;
   size_t memory_used_ = 0;
   PaintScratch scratch_;
+  LightScratch light_scratch_;
 };
 
 }  // namespace plumb::synth

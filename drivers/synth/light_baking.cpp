@@ -104,7 +104,13 @@ void bakeLightingPerTexel(const SceneModel& model, const SceneQuad& quad, double
   }
 }
 
-void bakeLighting(const SceneModel& model, const SceneQuad& quad, double texels_per_metre, cv::Mat& bgr) {
+void LightScratch::reserve(int cols) {
+  if (static_cast<int>(column_term.size()) < cols) column_term.resize(cols);
+  if (static_cast<int>(row_light.size()) < cols) row_light.resize(cols);
+}
+
+void bakeLighting(const SceneModel& model, const SceneQuad& quad, double texels_per_metre, cv::Mat& bgr,
+                  LightScratch& scratch) {
   const int a_u = worldAxisOf(quad.axis_u_world), a_v = worldAxisOf(quad.axis_v_world);
   const int a_n = worldAxisOf(quad.normal_world);
   const bool separable = a_u >= 0 && a_v >= 0 && a_n >= 0 && a_u != a_v && a_u != a_n && a_v != a_n &&
@@ -118,12 +124,13 @@ void bakeLighting(const SceneModel& model, const SceneQuad& quad, double texels_
   light.base = model.ambient + model.sun_strength * sun;
   light.lamp_strength = model.lamp_strength;
   light.facing = quad.normal_world[a_n] * (lamp[a_n] - origin[a_n]);
-  std::vector<float> row_light(bgr.cols);
+  scratch.reserve(bgr.cols);
+  float* row_light = scratch.row_light.data();
+  double* column_term = scratch.column_term.data();
   // Faces turned from the lamp, or no lamp: the lamp term is 0 and every texel gets the base.
   const bool lamp_reaches = light.facing > 0 && light.lamp_strength != 0;
-  if (!lamp_reaches) std::fill(row_light.begin(), row_light.end(), static_cast<float>(light.base));
+  if (!lamp_reaches) std::fill(row_light, row_light + bgr.cols, static_cast<float>(light.base));
 
-  std::vector<double> column_term(bgr.cols);
   for (int x = 0; x < bgr.cols; ++x) {
     const double s = texelCentre(x, texels_per_metre, quad.length_u);
     const double to_lamp = lamp[a_u] - (origin[a_u] + s);
@@ -145,9 +152,9 @@ void bakeLighting(const SceneModel& model, const SceneQuad& quad, double texels_
         light.row_first = axis_term[1 - a_u];
         light.row_second = axis_term[2];
       }
-      light.row(column_term.data(), bgr.cols, row_light.data());
+      light.row(column_term, bgr.cols, row_light);
     }
-    multiplyTexels(bgr.ptr<cv::Vec3b>(y), row_light.data(), bgr.cols);
+    multiplyTexels(bgr.ptr<cv::Vec3b>(y), row_light, bgr.cols);
   }
 }
 
