@@ -46,8 +46,4 @@ void BakedTextures::prepare(int quad_index) {
   texture.texels_per_metre = recipe.texels_per_metre;
 }
 
-void BakedTextures::prepareAll() {
-  for (int q = 0; q < static_cast<int>(model_.quads.size()); ++q) prepare(q);
-}
-
 }  // namespace plumb::synth

@@ -30,8 +30,6 @@ class BakedTextures {
 
   // Paints and lights quad_index's texture unless that is done already.
   void prepare(int quad_index);
-  // Paints every texture now (for callers that must not allocate later).
-  void prepareAll();
   // The texture of a prepared quad.
   const SurfaceTexture& texture(int quad_index) const { return textures_[model_.quads[quad_index].texture]; }
 
