@@ -16,7 +16,7 @@
 #include "drivers/dataset/camera_presets.h"
 #include "drivers/dataset/tum_dataset.h"
 #include "pipeline/frontend/feature_extractor.h"
-#include "platform/bench_timing.h"
+#include "platform/stage_timing.h"
 #include "tools/args.h"
 #include "tools/command.h"
 

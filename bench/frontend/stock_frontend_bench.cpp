@@ -24,11 +24,11 @@
 #include "drivers/dataset/camera_presets.h"
 #include "drivers/dataset/tum_dataset.h"
 #include "pipeline/frontend/feature_extractor.h"
-#include "platform/bench_timing.h"
+#include "platform/stage_timing.h"
 
 namespace {
 
-using plumb::BenchClock;
+using plumb::StageClock;
 using plumb::TimingSeries;
 using plumb::msSince;
 using plumb::threadCpuMs;
@@ -48,18 +48,18 @@ struct StockPath {
 
   void run(const cv::Mat& bgr) {
     cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
-    auto t = BenchClock::now();
+    auto t = StageClock::now();
     double cpu = threadCpuMs();
     orb->detectAndCompute(grey, cv::noArray(), keypoints, descriptors);
     orb_ms = msSince(t);
     orb_cpu_ms = threadCpuMs() - cpu;
-    t = BenchClock::now();
+    t = StageClock::now();
     cpu = threadCpuMs();
     keylines.clear();
     lsd->detect(grey, keylines, 2, 1);
     lsd_ms = msSince(t);
     lsd_cpu_ms = threadCpuMs() - cpu;
-    t = BenchClock::now();
+    t = StageClock::now();
     cpu = threadCpuMs();
     lbd->compute(grey, keylines, line_descriptors);
     lbd_ms = msSince(t);
@@ -114,7 +114,7 @@ int main(int argc, char** argv) {
     }
     total.ms.push_back(extractor.lastTimings().total_ms);
     cpu_total.ms.push_back(extractor.lastTimings().total_cpu_ms);
-    const auto t0 = BenchClock::now();
+    const auto t0 = StageClock::now();
     const double cpu0 = threadCpuMs();
     stock.run(frame.bgr);
     s_total.ms.push_back(msSince(t0));

@@ -1,16 +1,17 @@
 #pragma once
-// Timing helpers of the benchmark programs (`plumb bench`, bench/): wall milliseconds since a
-// steady-clock instant, the calling thread's CPU time, and a series of per-frame times summarised
-// by percentiles. Benchmarks only: the runtime's own latencies use monotonic_time.h.
+// Timing of processing stages: wall milliseconds since a steady-clock instant and the calling
+// thread's CPU time (the front end's per-stage timings, `plumb bench`, bench/), and a series of
+// per-frame times summarised by percentiles (the benchmarks' tables). Latencies between threads
+// and pacing use monotonic_time.h.
 #include <chrono>
 #include <vector>
 
 namespace plumb {
 
-using BenchClock = std::chrono::steady_clock;
+using StageClock = std::chrono::steady_clock;
 
 // Wall milliseconds from `start` to now.
-double msSince(BenchClock::time_point start);
+double msSince(StageClock::time_point start);
 
 // CPU time the calling thread has used, in milliseconds (CLOCK_THREAD_CPUTIME_ID).
 double threadCpuMs();

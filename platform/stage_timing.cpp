@@ -1,4 +1,4 @@
-#include "platform/bench_timing.h"
+#include "platform/stage_timing.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -6,8 +6,8 @@
 
 namespace plumb {
 
-double msSince(BenchClock::time_point start) {
-  return std::chrono::duration<double, std::milli>(BenchClock::now() - start).count();
+double msSince(StageClock::time_point start) {
+  return std::chrono::duration<double, std::milli>(StageClock::now() - start).count();
 }
 
 double threadCpuMs() {
