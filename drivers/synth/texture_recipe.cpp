@@ -106,6 +106,15 @@ void replay(const PaintOp& op, cv::Mat& bgr) {
 }
 
 // Multiplies the texture by the smoothly upsampled coarse gains (stains, uneven paint).
+// bgr.setTo(colour) without cv::Mat::setTo's scratch buffer, which comes from operator new for
+// rows wider than ~340 texels (a face first seen in a steady run must not allocate). The same
+// bytes: each channel is saturate_cast<uchar> of the colour, as setTo converts it.
+void fillTexels(cv::Mat& bgr, const cv::Scalar& colour) {
+  const cv::Vec3b texel(cv::saturate_cast<uchar>(colour[0]), cv::saturate_cast<uchar>(colour[1]),
+                        cv::saturate_cast<uchar>(colour[2]));
+  for (int y = 0; y < bgr.rows; ++y) std::fill_n(bgr.ptr<cv::Vec3b>(y), bgr.cols, texel);
+}
+
 // A rows x cols view of `buffer`, grown (never shrunk) to hold it.
 cv::Mat viewOf(cv::Mat& buffer, int rows, int cols, int type) {
   const size_t bytes = static_cast<size_t>(rows) * cols * CV_ELEM_SIZE(type);
@@ -144,7 +153,7 @@ void paintTexture(const TextureRecipe& recipe, PaintScratch& scratch, cv::Mat& b
   // is just its colour.
   bgr.create(recipe.rows, recipe.cols, CV_8UC3);
   cv::Mat canvas = procedural ? viewOf(scratch.canvas, recipe.rows, recipe.cols, CV_8UC3) : bgr;
-  canvas.setTo(recipe.base_bgr);
+  fillTexels(canvas, recipe.base_bgr);
   for (const PaintOp& op : recipe.ops) replay(op, canvas);
   if (!procedural) return;
   applyShading(recipe, scratch.gain, canvas);
