@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include <opencv2/imgproc.hpp>
 
@@ -112,7 +113,10 @@ void replay(const PaintOp& op, cv::Mat& bgr) {
 void fillTexels(cv::Mat& bgr, const cv::Scalar& colour) {
   const cv::Vec3b texel(cv::saturate_cast<uchar>(colour[0]), cv::saturate_cast<uchar>(colour[1]),
                         cv::saturate_cast<uchar>(colour[2]));
-  for (int y = 0; y < bgr.rows; ++y) std::fill_n(bgr.ptr<cv::Vec3b>(y), bgr.cols, texel);
+  if (bgr.rows == 0) return;
+  std::fill_n(bgr.ptr<cv::Vec3b>(0), bgr.cols, texel);
+  const size_t row_bytes = static_cast<size_t>(bgr.cols) * sizeof(cv::Vec3b);
+  for (int y = 1; y < bgr.rows; ++y) std::memcpy(bgr.ptr(y), bgr.ptr(0), row_bytes);  // memcpy is vectorised
 }
 
 // A rows x cols view of `buffer`, grown (never shrunk) to hold it.
