@@ -49,22 +49,18 @@ void toTrackOutput(const FrameOutput& f, TrackOutput* out) {
   out->line_inliers = f.track.line_inliers;
 }
 
-FinishedPose toFinished(const FinishedFrame& f) {
-  FinishedPose p;
-  p.sequence = f.sequence;
-  p.timestamp_s = f.timestamp_s;
-  p.valid = f.valid;
-  p.dropped = f.dropped;
-  p.T_world_cam = f.T_world_cam;
-  return p;
-}
-
 FinishedPose toFinished(const StampedPose& s) {
   FinishedPose p;
   p.timestamp_s = s.timestamp;
   p.valid = s.valid;
   p.dropped = s.dropped;
   p.T_world_cam = s.T_world_cam;
+  return p;
+}
+
+FinishedPose toFinished(const FinishedFrame& f) {
+  FinishedPose p = toFinished(toStampedPose(f));
+  p.sequence = f.sequence;
   return p;
 }
 

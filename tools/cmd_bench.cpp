@@ -6,9 +6,7 @@
 // build/bin/plumb_bench_stock_frontend (bench/frontend/), so that `plumb` does not link
 // features2d and line_descriptor (docs/EMBEDDED.md).
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
-#include <ctime>
 #include <memory>
 #include <string>
 #include <vector>
@@ -18,32 +16,14 @@
 #include "drivers/dataset/camera_presets.h"
 #include "drivers/dataset/tum_dataset.h"
 #include "pipeline/frontend/feature_extractor.h"
+#include "platform/stage_timing.h"
 #include "tools/args.h"
 #include "tools/command.h"
 
 namespace plumb::tools {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
-double threadCpuMs() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
-
-struct Series {
-  const char* name;
-  std::vector<double> ms;
-  double percentile(double p) const {
-    if (ms.empty()) return 0;
-    std::vector<double> s = ms;
-    std::sort(s.begin(), s.end());
-    const size_t i = std::min(s.size() - 1, static_cast<size_t>(p * (s.size() - 1) + 0.5));
-    return s[i];
-  }
-  void print() const { std::printf("  %-24s median %7.2f ms   p99 %7.2f ms\n", name, percentile(0.5), percentile(0.99)); }
-};
+constexpr int kNameWidth = 24;
 
 void printUsage() {
   std::printf(
@@ -127,9 +107,9 @@ int benchFrontend(int argc, char** argv) {
     if (dump == nullptr) { std::fprintf(stderr, "plumb bench frontend: cannot write %s\n", args.get("dump").c_str()); return 1; }
   }
 
-  Series orb{"ORB", {}}, lines{"lines + LBD", {}}, depth{"depth + sampling", {}}, total{"frontend total", {}};
-  Series cpu_orb{"ORB (CPU)", {}}, cpu_lines{"lines + LBD (CPU)", {}}, cpu_depth{"depth + sampling (CPU)", {}};
-  Series cpu_total{"frontend total (CPU)", {}};
+  TimingSeries orb{"ORB", {}}, lines{"lines + LBD", {}}, depth{"depth + sampling", {}}, total{"frontend total", {}};
+  TimingSeries cpu_orb{"ORB (CPU)", {}}, cpu_lines{"lines + LBD (CPU)", {}}, cpu_depth{"depth + sampling (CPU)", {}};
+  TimingSeries cpu_total{"frontend total (CPU)", {}};
   double sum_kp = 0, sum_kp_depth = 0, sum_lines = 0, sum_lines3d = 0;
   RgbdImage frame;
   const size_t n = max_frames > 0 ? std::min<size_t>(source->size(), max_frames) : source->size();
@@ -175,14 +155,14 @@ int benchFrontend(int argc, char** argv) {
   std::printf("plumb bench frontend: %zu frames of %s, 1 thread\n", n, args.get("dataset").c_str());
   std::printf("  per frame: %.0f keypoints (%.0f with depth), %.0f lines (%.0f with a 3D fit, %d samples max)\n",
               sum_kp / frames, sum_kp_depth / frames, sum_lines / frames, sum_lines3d / frames, options.line_samples);
-  orb.print();
-  lines.print();
-  depth.print();
-  total.print();
-  cpu_orb.print();
-  cpu_lines.print();
-  cpu_depth.print();
-  cpu_total.print();
+  orb.print(kNameWidth);
+  lines.print(kNameWidth);
+  depth.print(kNameWidth);
+  total.print(kNameWidth);
+  cpu_orb.print(kNameWidth);
+  cpu_lines.print(kNameWidth);
+  cpu_depth.print(kNameWidth);
+  cpu_total.print(kNameWidth);
   std::printf("  stock OpenCV comparison (cv::ORB + line_descriptor): build/bin/plumb_bench_stock_frontend\n"
               "  --dataset %s (a separate program, so that plumb does not link those libraries)\n",
               args.get("dataset").c_str());

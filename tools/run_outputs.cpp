@@ -8,6 +8,7 @@
 #include "platform/process_memory.h"
 
 #include "drivers/common/source_capture.h"
+#include "pipeline/odometry/odometry_trajectory.h"
 
 namespace plumb::tools {
 
@@ -125,11 +126,7 @@ Status RunOutputs::onFrame(const FrameOutput& out) {
 }
 
 Status RunOutputs::onFinishedFrame(const FinishedFrame& f) {
-  StampedPose pose;
-  pose.timestamp = f.timestamp_s;
-  pose.T_world_cam = f.T_world_cam;
-  pose.valid = f.valid;
-  pose.dropped = f.dropped;
+  const StampedPose pose = toStampedPose(f);
   if (options_.keep_trajectory) trajectory_.push_back(pose);
   if (frames_stream_ != nullptr) {
     StreamedFrame r;

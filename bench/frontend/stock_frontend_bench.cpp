@@ -12,7 +12,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <ctime>
 #include <memory>
 #include <string>
 #include <vector>
@@ -25,29 +24,15 @@
 #include "drivers/dataset/camera_presets.h"
 #include "drivers/dataset/tum_dataset.h"
 #include "pipeline/frontend/feature_extractor.h"
+#include "platform/stage_timing.h"
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
-double threadCpuMs() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
-
-struct Series {
-  const char* name;
-  std::vector<double> ms;
-  double percentile(double p) const {
-    if (ms.empty()) return 0;
-    std::vector<double> s = ms;
-    std::sort(s.begin(), s.end());
-    const size_t i = std::min(s.size() - 1, static_cast<size_t>(p * (s.size() - 1) + 0.5));
-    return s[i];
-  }
-  void print() const { std::printf("  %-26s median %7.2f ms   p99 %7.2f ms\n", name, percentile(0.5), percentile(0.99)); }
-};
+using plumb::StageClock;
+using plumb::TimingSeries;
+using plumb::msSince;
+using plumb::threadCpuMs;
+constexpr int kNameWidth = 26;
 
 // cv::ORB 1000 features, 8 levels, 1.2, and the contrib LSDDetector + BinaryDescriptor (LBD) on
 // every detected line.
@@ -63,18 +48,18 @@ struct StockPath {
 
   void run(const cv::Mat& bgr) {
     cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
-    auto t = Clock::now();
+    auto t = StageClock::now();
     double cpu = threadCpuMs();
     orb->detectAndCompute(grey, cv::noArray(), keypoints, descriptors);
     orb_ms = msSince(t);
     orb_cpu_ms = threadCpuMs() - cpu;
-    t = Clock::now();
+    t = StageClock::now();
     cpu = threadCpuMs();
     keylines.clear();
     lsd->detect(grey, keylines, 2, 1);
     lsd_ms = msSince(t);
     lsd_cpu_ms = threadCpuMs() - cpu;
-    t = Clock::now();
+    t = StageClock::now();
     cpu = threadCpuMs();
     lbd->compute(grey, keylines, line_descriptors);
     lbd_ms = msSince(t);
@@ -112,10 +97,10 @@ int main(int argc, char** argv) {
   FeatureExtractor extractor(camera, ExtractorOptions{});
   auto features = std::make_unique<FrameFeatures>();
   StockPath stock;
-  Series total{"plumb frontend total", {}}, cpu_total{"plumb frontend (CPU)", {}};
-  Series s_orb{"stock cv::ORB", {}}, s_lsd{"stock LSDDetector", {}}, s_lbd{"stock BinaryDescriptor", {}},
+  TimingSeries total{"plumb frontend total", {}}, cpu_total{"plumb frontend (CPU)", {}};
+  TimingSeries s_orb{"stock cv::ORB", {}}, s_lsd{"stock LSDDetector", {}}, s_lbd{"stock BinaryDescriptor", {}},
       s_total{"stock total", {}};
-  Series s_cpu_orb{"stock cv::ORB (CPU)", {}}, s_cpu_lsd{"stock LSDDetector (CPU)", {}},
+  TimingSeries s_cpu_orb{"stock cv::ORB (CPU)", {}}, s_cpu_lsd{"stock LSDDetector (CPU)", {}},
       s_cpu_lbd{"stock BinaryDesc. (CPU)", {}}, s_cpu_total{"stock total (CPU)", {}};
   double sum_stock_lines = 0;
   RgbdImage frame;
@@ -129,7 +114,7 @@ int main(int argc, char** argv) {
     }
     total.ms.push_back(extractor.lastTimings().total_ms);
     cpu_total.ms.push_back(extractor.lastTimings().total_cpu_ms);
-    const auto t0 = Clock::now();
+    const auto t0 = StageClock::now();
     const double cpu0 = threadCpuMs();
     stock.run(frame.bgr);
     s_total.ms.push_back(msSince(t0));
@@ -144,9 +129,9 @@ int main(int argc, char** argv) {
   }
   std::printf("plumb_bench_stock_frontend: %zu frames of %s, 1 thread\n", n, dataset);
   std::printf("  stock path: %.0f lines described per frame\n", sum_stock_lines / std::max<size_t>(n, 1));
-  for (const Series* s : {&total, &cpu_total, &s_orb, &s_lsd, &s_lbd, &s_total, &s_cpu_orb, &s_cpu_lsd, &s_cpu_lbd,
+  for (const TimingSeries* s : {&total, &cpu_total, &s_orb, &s_lsd, &s_lbd, &s_total, &s_cpu_orb, &s_cpu_lsd, &s_cpu_lbd,
                           &s_cpu_total})
-    s->print();
+    s->print(kNameWidth);
   std::printf("  speed-up (stock / plumb, medians): wall %.1fx, CPU %.1fx\n",
               s_total.percentile(0.5) / total.percentile(0.5), s_cpu_total.percentile(0.5) / cpu_total.percentile(0.5));
   std::printf("summary clock: %s\n", cpu_clock ? "thread CPU time" : "wall (steady clock)");

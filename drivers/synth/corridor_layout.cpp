@@ -29,7 +29,7 @@ class CorridorBuilder {
       double tpm = big ? options_.wall_texels_per_metre : options_.object_texels_per_metre;
       if (style == TextureStyle::kCeiling) tpm = options_.wall_texels_per_metre / 3;
       quad.texture = static_cast<int>(model_.textures.size());
-      model_.textures.push_back(makeSurfaceTexture(quad.length_u, quad.length_v, tpm, style, quad.albedo_bgr, rng));
+      model_.textures.push_back(planSurfaceTexture(quad.length_u, quad.length_v, tpm, style, quad.albedo_bgr, rng));
     }
   }
 
@@ -119,7 +119,7 @@ SceneModel buildCorridor(const CorridorLayoutOptions& options) {
               kFaceMaxX);
   builder.box({kCorridorLength, 0, 0}, {kCorridorLength + 0.1, kCorridorWidth, kCorridorHeight}, colours.wall_north,
               TextureStyle::kWall, kEndWalls + 500, kFaceMinX);
-  bakeLighting(model, options.lightmap_texels_per_metre);
+  planLightMaps(model, options.lightmap_texels_per_metre);
   return model;
 }
 

@@ -34,15 +34,25 @@ int clipToNearPlane(const Eigen::Vector3d* in, int count, Eigen::Vector3d* out) 
 }  // namespace
 
 FrameRenderer::FrameRenderer(const SceneModel& model, const PinholeCamera& camera)
-    : model_(model), camera_(camera) {
+    : model_(model), camera_(camera), textures_(model) {
   quads_cam_.resize(model.quads.size());
   ray_x_.resize(camera.width);
   ray_y_.resize(camera.height);
   for (int x = 0; x < camera.width; ++x) ray_x_[x] = (x - camera.cx) / camera.fx;
   for (int y = 0; y < camera.height; ++y) ray_y_[y] = (y - camera.cy) / camera.fy;
-  quad_id_.resize(static_cast<size_t>(camera.width) * camera.height);
-  colour_bgr_.create(camera.height, camera.width, CV_32FC3);
-  depth_m_.create(camera.height, camera.width, CV_32FC1);
+  // Colour, depth and quad ids in one huge-page block (few page faults on the first frame).
+  const size_t pixels = static_cast<size_t>(camera.width) * camera.height;
+  buffers_ = HugePageBuffer(pixels * (sizeof(cv::Vec3f) + sizeof(float) + sizeof(int32_t)));
+  if (buffers_.data()) {
+    colour_bgr_ = cv::Mat(camera.height, camera.width, CV_32FC3, buffers_.data());
+    depth_m_ = cv::Mat(camera.height, camera.width, CV_32FC1, buffers_.data() + pixels * sizeof(cv::Vec3f));
+    quad_id_ = reinterpret_cast<int32_t*>(buffers_.data() + pixels * (sizeof(cv::Vec3f) + sizeof(float)));
+  } else {
+    colour_bgr_.create(camera.height, camera.width, CV_32FC3);
+    depth_m_.create(camera.height, camera.width, CV_32FC1);
+    fallback_quad_id_.resize(pixels);
+    quad_id_ = fallback_quad_id_.data();
+  }
 }
 
 void FrameRenderer::render(const Eigen::Isometry3d& T_world_cam) {
@@ -50,9 +60,11 @@ void FrameRenderer::render(const Eigen::Isometry3d& T_world_cam) {
   // Plain fill: cv::Mat::setTo allocates a scratch buffer on every call.
   float* depth = depth_m_.ptr<float>();
   std::fill(depth, depth + depth_m_.total(), std::numeric_limits<float>::infinity());
-  std::fill(quad_id_.begin(), quad_id_.end(), -1);
+  std::fill(quad_id_, quad_id_ + depth_m_.total(), -1);
+  // Shading samples only quads whose id is in the z-buffer (pixel centres, and the 3x3
+  // neighbourhoods supersampled at edges), all of which won a pixel while rasterising.
   for (int q = 0; q < static_cast<int>(quads_cam_.size()); ++q)
-    if (quads_cam_[q].facing) rasteriseQuad(q);
+    if (quads_cam_[q].facing && rasteriseQuad(q)) textures_.prepare(q);
   shadePixels();
 }
 
@@ -71,7 +83,7 @@ void FrameRenderer::transformQuads(const Eigen::Isometry3d& T_world_cam) {
   }
 }
 
-void FrameRenderer::rasteriseQuad(int quad_index) {
+bool FrameRenderer::rasteriseQuad(int quad_index) {
   const SceneQuad& quad = model_.quads[quad_index];
   const QuadInCamera& qc = quads_cam_[quad_index];
   const Eigen::Vector3d corners[4] = {qc.origin, qc.origin + qc.axis_u * quad.length_u,
@@ -79,7 +91,8 @@ void FrameRenderer::rasteriseQuad(int quad_index) {
                                       qc.origin + qc.axis_v * quad.length_v};
   Eigen::Vector3d clipped[8];
   const int count = clipToNearPlane(corners, 4, clipped);
-  if (count < 3) return;
+  if (count < 3) return false;
+  bool won_a_pixel = false;
   double px[8], py[8];
   double y_min = std::numeric_limits<double>::infinity(), y_max = -y_min;
   for (int i = 0; i < count; ++i) {
@@ -112,7 +125,7 @@ void FrameRenderer::rasteriseQuad(int quad_index) {
     const int col_end = std::min(width - 1, static_cast<int>(std::floor(x_right + kSpanSlackPx)));
     if (col_begin > col_end) continue;
     float* depth_row = depth_m_.ptr<float>(y);
-    int32_t* id_row = quad_id_.data() + static_cast<size_t>(y) * width;
+    int32_t* id_row = quad_id_ + static_cast<size_t>(y) * width;
     const double row_term = qc.normal.y() * ray_y_[y] + qc.normal.z();
     for (int x = col_begin; x <= col_end; ++x) {
       const double denominator = qc.normal.x() * ray_x_[x] + row_term;  // n . r, r = (rx, ry, 1)
@@ -121,9 +134,11 @@ void FrameRenderer::rasteriseQuad(int quad_index) {
       if (z < depth_row[x]) {
         depth_row[x] = static_cast<float>(z);
         id_row[x] = quad_index;
+        won_a_pixel = true;
       }
     }
   }
+  return won_a_pixel;
 }
 
 int FrameRenderer::castRay(double u, double v, const int* candidates, int count, double* z) const {
@@ -148,7 +163,7 @@ int FrameRenderer::castRay(double u, double v, const int* candidates, int count,
   return best;
 }
 
-cv::Vec3f FrameRenderer::sampleTexture(const SurfaceTexture& texture, double s_m, double t_m) const {
+inline cv::Vec3f FrameRenderer::sampleTexture(const SurfaceTexture& texture, double s_m, double t_m) const {
   const cv::Mat& bgr = texture.bgr;
   const float x = std::clamp(static_cast<float>(s_m * texture.texels_per_metre) - 0.5f, 0.0f, bgr.cols - 1.001f);
   const float y = std::clamp(static_cast<float>(t_m * texture.texels_per_metre) - 0.5f, 0.0f, bgr.rows - 1.001f);
@@ -162,12 +177,11 @@ cv::Vec3f FrameRenderer::sampleTexture(const SurfaceTexture& texture, double s_m
                    w00 * p00[2] + w01 * p00[5] + w10 * p10[2] + w11 * p10[5]);
 }
 
-cv::Vec3f FrameRenderer::shadePoint(int quad_index, const Eigen::Vector3d& P_cam) const {
+inline cv::Vec3f FrameRenderer::shadePoint(int quad_index, const Eigen::Vector3d& P_cam) const {
   // Lighting is baked into the texture (light_baking.h): shading is one bilinear lookup.
   const QuadInCamera& qc = quads_cam_[quad_index];
   const Eigen::Vector3d offset = P_cam - qc.origin;
-  return sampleTexture(model_.textures[model_.quads[quad_index].texture], offset.dot(qc.axis_u),
-                       offset.dot(qc.axis_v));
+  return sampleTexture(textures_.texture(quad_index), offset.dot(qc.axis_u), offset.dot(qc.axis_v));
 }
 
 void FrameRenderer::shadePixels() {
@@ -175,7 +189,7 @@ void FrameRenderer::shadePixels() {
   edge_pixels_ = 0;
   for (int y = 0; y < height; ++y) {
     const float* depth_row = depth_m_.ptr<float>(y);
-    const int32_t* id_row = quad_id_.data() + static_cast<size_t>(y) * width;
+    const int32_t* id_row = quad_id_ + static_cast<size_t>(y) * width;
     cv::Vec3f* colour_row = colour_bgr_.ptr<cv::Vec3f>(y);
     for (int x = 0; x < width; ++x) {
       const int id = id_row[x];

@@ -6,27 +6,32 @@
 //     to the near plane, projected, and filled span by span; depth at a pixel centre is the exact
 //     ray-plane intersection z = d / (n . r), so depth is exact up to float rounding (no
 //     interpolation error, which the reprojection test relies on).
-//  2. Shade: a bilinear lookup in the face's texture, lighting baked in (light_baking.h). Pixels whose
+//  2. Shade: a bilinear lookup in the face's texture, lighting baked in (light_baking.h), painted
+//     when a frame first shows the face (baked_textures.h: only quads that won a pixel in pass 1
+//     are ever sampled, so the first frame paints only what it sees). Pixels whose
 //     4-neighbours carry another quad id lie on a silhouette or crease: they are supersampled
 //     3x3 by ray casting against the quads of their 3x3 neighbourhood, so edges are anti-aliased
 //     and the line detector sees clean straight segments. Depth stays the centre sample (a real
 //     sensor does not blend depths either).
 // Shading is view-independent (Lambert), so a surface point has the same colour in every frame.
-// Every quad must have a texture (bakeLighting gives flat faces a light map).
+// Every quad must have a texture recipe (planLightMaps gives flat faces a light map).
 #include <cstdint>
 #include <vector>
 
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
+#include "drivers/synth/baked_textures.h"
 #include "drivers/synth/scene_model.h"
+#include "platform/huge_page_buffer.h"
 #include "sensor/camera.h"
 
 namespace plumb::synth {
 
 class FrameRenderer {
  public:
-  // Keeps references to model and camera (both must outlive the renderer); allocates all buffers.
+  // Keeps references to model and camera (both must outlive the renderer); allocates all buffers
+  // but the textures, which are painted as frames first show their faces.
   FrameRenderer(const SceneModel& model, const PinholeCamera& camera);
 
   void render(const Eigen::Isometry3d& T_world_cam);
@@ -46,7 +51,8 @@ class FrameRenderer {
   };
 
   void transformQuads(const Eigen::Isometry3d& T_world_cam);
-  void rasteriseQuad(int quad_index);
+  // Returns whether the quad won at least one pixel (so far: a later quad may cover it again).
+  bool rasteriseQuad(int quad_index);
   void shadePixels();
   // Nearest quad among `candidates` hit by the ray through (u, v); -1 if none. Sets *z.
   int castRay(double u, double v, const int* candidates, int count, double* z) const;
@@ -55,10 +61,13 @@ class FrameRenderer {
 
   const SceneModel& model_;
   const PinholeCamera& camera_;
+  BakedTextures textures_;
   std::vector<QuadInCamera> quads_cam_;
   std::vector<double> ray_x_, ray_y_;  // (u - cx) / fx per column, (v - cy) / fy per row
-  std::vector<int32_t> quad_id_;       // per pixel, -1 = nothing
+  HugePageBuffer buffers_;             // holds the three below
+  int32_t* quad_id_ = nullptr;         // per pixel, -1 = nothing
   cv::Mat colour_bgr_, depth_m_;
+  std::vector<int32_t> fallback_quad_id_;  // quad_id_'s memory if buffers_ could not be had
   int edge_pixels_ = 0;
 };
 

@@ -48,7 +48,7 @@ class RoomBuilder {
     if (style == TextureStyle::kCeiling) tpm = options_.wall_texels_per_metre / 3;
     quad.texture = static_cast<int>(model_.textures.size());
     model_.textures.push_back(
-        makeSurfaceTexture(quad.length_u, quad.length_v, tpm, style, quad.albedo_bgr, texture_rng_));
+        planSurfaceTexture(quad.length_u, quad.length_v, tpm, style, quad.albedo_bgr, texture_rng_));
   }
 
   // A framed picture on a wall whose inward normal is `normal` (axis-aligned, horizontal).
@@ -206,7 +206,7 @@ SceneModel buildRoom(const RoomLayoutOptions& options) {
   addSouthWall(builder);
   addWestWall(builder);
   addCentre(builder);
-  bakeLighting(model, options.lightmap_texels_per_metre);
+  planLightMaps(model, options.lightmap_texels_per_metre);
   return model;
 }
 

@@ -1,8 +1,9 @@
 #pragma once
 // The synthetic room as the renderer sees it: a list of one-sided planar rectangles ("quads") in
-// the world frame, each with a flat colour or its own texture image, and one light setup.
-// Lighting is view-independent (Lambert), so light_baking.h multiplies it into the textures once
-// and rendering a pixel is a single texture lookup.
+// the world frame, each with its own texture (a recipe, painted when a frame first sees the quad:
+// texture_recipe.h, baked_textures.h) and one light setup. Lighting is view-independent (Lambert),
+// so light_baking.h multiplies it into a face's texture once, as it is painted, and rendering a
+// pixel is a single texture lookup.
 //
 // Everything in the room is built from axis-aligned boxes (walls are the inside of one big box),
 // so a quad is origin + two perpendicular edges. A quad is visible only from its front (the side
@@ -13,6 +14,8 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
+#include "drivers/synth/texture_recipe.h"
+
 namespace plumb::synth {
 
 struct SceneQuad {
@@ -22,18 +25,12 @@ struct SceneQuad {
   Eigen::Vector3d normal_world;  // unit front normal
   double length_u = 0, length_v = 0;  // edge lengths in metres
   cv::Vec3f albedo_bgr;               // flat colour (0..255) of untextured faces
-  int texture = -1;                   // index into SceneModel::textures, or -1 (until baked)
-};
-
-// A texture covers its quad exactly: texel (x, y) <-> (u, v) = ((x + 0.5), (y + 0.5)) / texels_per_metre.
-struct SurfaceTexture {
-  cv::Mat bgr;  // CV_8UC3
-  double texels_per_metre = 0;
+  int texture = -1;                   // index into SceneModel::textures; -1 until planLightMaps
 };
 
 struct SceneModel {
   std::vector<SceneQuad> quads;
-  std::vector<SurfaceTexture> textures;
+  std::vector<TextureRecipe> textures;  // each quad its own (each face is lit on its own texels)
   Eigen::Vector3d room_min_world = Eigen::Vector3d::Zero();  // interior of the room
   Eigen::Vector3d room_max_world = Eigen::Vector3d::Zero();
   // A soft point light near the ceiling adds smooth gradients (no corners) across every face.

@@ -1,11 +1,12 @@
-// Procedural surface textures (see surface_texture.h). Only OpenCV drawing calls and our own
-// SplitMix64 draws are used, so a seed always produces the same texels.
+// Procedural surface textures (see surface_texture.h). Only OpenCV drawing calls (recorded, then
+// replayed by paintTexture) and our own SplitMix64 draws are used, so a seed always produces the
+// same texels.
 #include "drivers/synth/surface_texture.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include <opencv2/imgproc.hpp>
+#include <opencv2/imgproc.hpp>  // cv::FILLED, cv::LINE_AA
 
 namespace plumb::synth {
 namespace {
@@ -14,32 +15,26 @@ cv::Scalar randomColour(SplitMix64& rng, double lo = 20, double hi = 235) {
   return cv::Scalar(rng.uniform(lo, hi), rng.uniform(lo, hi), rng.uniform(lo, hi));
 }
 
-// Multiplies the texture by smooth brightness variations of about +-15% (stains, uneven paint).
-void applyLowFrequencyShading(cv::Mat& bgr, double texels_per_metre, SplitMix64& rng) {
+// Smooth brightness variations of about +-15% (stains, uneven paint), multiplied in at painting.
+void drawLowFrequencyShading(TextureRecipe& recipe, double texels_per_metre, SplitMix64& rng) {
   const int cell = std::max(4, static_cast<int>(0.25 * texels_per_metre));  // ~25 cm features
-  cv::Mat coarse(bgr.rows / cell + 2, bgr.cols / cell + 2, CV_32F);
+  cv::Mat coarse(recipe.rows / cell + 2, recipe.cols / cell + 2, CV_32F);
   for (int r = 0; r < coarse.rows; ++r)
     for (int c = 0; c < coarse.cols; ++c) coarse.at<float>(r, c) = static_cast<float>(rng.uniform(0.85, 1.15));
-  cv::Mat gain;
-  cv::resize(coarse, gain, cv::Size(coarse.cols * cell, coarse.rows * cell), 0, 0, cv::INTER_CUBIC);
-  for (int r = 0; r < bgr.rows; ++r) {
-    cv::Vec3b* row = bgr.ptr<cv::Vec3b>(r);
-    const float* g = gain.ptr<float>(r);
-    for (int c = 0; c < bgr.cols; ++c)
-      for (int k = 0; k < 3; ++k) row[c][k] = cv::saturate_cast<uchar>(row[c][k] * g[c]);
-  }
+  recipe.shading_gain_coarse = coarse;
+  recipe.shading_cell = cell;
 }
 
-void drawBlobs(cv::Mat& bgr, double tpm, double per_m2, double min_m, double max_m, SplitMix64& rng) {
-  const double area_m2 = bgr.cols * bgr.rows / (tpm * tpm);
+void drawBlobs(TextureCanvas& canvas, double tpm, double per_m2, double min_m, double max_m, SplitMix64& rng) {
+  const double area_m2 = canvas.cols * canvas.rows / (tpm * tpm);
   const int count = static_cast<int>(area_m2 * per_m2);
   for (int i = 0; i < count; ++i) {
-    const cv::Point centre(rng.uniformInt(0, bgr.cols - 1), rng.uniformInt(0, bgr.rows - 1));
+    const cv::Point centre(rng.uniformInt(0, canvas.cols - 1), rng.uniformInt(0, canvas.rows - 1));
     const cv::Size axes(std::max(2, static_cast<int>(rng.uniform(min_m, max_m) * tpm)),
                         std::max(2, static_cast<int>(rng.uniform(min_m, max_m) * tpm)));
     const double angle = rng.uniform(0, 180);
     if (rng.uniform() < 0.7) {
-      cv::ellipse(bgr, centre, axes, angle, 0, 360, randomColour(rng), cv::FILLED, cv::LINE_AA);
+      canvas.ellipse(centre, axes, angle, randomColour(rng), cv::FILLED, cv::LINE_AA);
     } else {  // rotated squares and triangles give sharp corners
       const int sides = rng.uniform() < 0.5 ? 3 : 4;
       cv::Point corners[4];
@@ -48,114 +43,106 @@ void drawBlobs(cv::Mat& bgr, double tpm, double per_m2, double min_m, double max
         corners[k] = centre + cv::Point(static_cast<int>(axes.width * std::cos(a)),
                                         static_cast<int>(axes.width * std::sin(a)));
       }
-      cv::fillConvexPoly(bgr, corners, sides, randomColour(rng), cv::LINE_AA);
+      canvas.fillConvexPoly(corners, sides, randomColour(rng), cv::LINE_AA);
     }
   }
 }
 
-void drawCheckerPatch(cv::Mat& bgr, double tpm, SplitMix64& rng) {
+void drawCheckerPatch(TextureCanvas& canvas, double tpm, SplitMix64& rng) {
   const int square = std::max(3, static_cast<int>(rng.uniform(0.03, 0.07) * tpm));
   const int nx = rng.uniformInt(3, 8), ny = rng.uniformInt(3, 8);
-  const int x0 = rng.uniformInt(0, std::max(0, bgr.cols - nx * square));
-  const int y0 = rng.uniformInt(0, std::max(0, bgr.rows - ny * square));
+  const int x0 = rng.uniformInt(0, std::max(0, canvas.cols - nx * square));
+  const int y0 = rng.uniformInt(0, std::max(0, canvas.rows - ny * square));
   const cv::Scalar dark = randomColour(rng, 10, 90), light = randomColour(rng, 160, 250);
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i < nx; ++i)
-      cv::rectangle(bgr, cv::Rect(x0 + i * square, y0 + j * square, square, square),
-                    (i + j) % 2 ? dark : light, cv::FILLED);
+      canvas.rectangle(cv::Rect(x0 + i * square, y0 + j * square, square, square), (i + j) % 2 ? dark : light,
+                    cv::FILLED);
 }
 
 // A framed rectangle with stripes, discs or bars inside.
-void drawPoster(cv::Mat& bgr, double tpm, SplitMix64& rng) {
+void drawPoster(TextureCanvas& canvas, double tpm, SplitMix64& rng) {
   const int w = static_cast<int>(rng.uniform(0.3, 0.9) * tpm), h = static_cast<int>(rng.uniform(0.3, 0.8) * tpm);
-  if (w >= bgr.cols || h >= bgr.rows) return;
-  const cv::Rect rect(rng.uniformInt(0, bgr.cols - w - 1), rng.uniformInt(0, bgr.rows - h - 1), w, h);
-  cv::rectangle(bgr, rect, randomColour(rng, 60, 240), cv::FILLED);
-  cv::Mat inner = bgr(rect);
+  if (w >= canvas.cols || h >= canvas.rows) return;
+  const cv::Rect rect(rng.uniformInt(0, canvas.cols - w - 1), rng.uniformInt(0, canvas.rows - h - 1), w, h);
+  canvas.rectangle(rect, randomColour(rng, 60, 240), cv::FILLED);
+  TextureCanvas inner = canvas.region(rect);
   const int kind = rng.uniformInt(0, 2);
   const int items = rng.uniformInt(6, 16);
   for (int i = 0; i < items; ++i) {
     const cv::Scalar colour = randomColour(rng);
     if (kind == 0) {
       const int y = rng.uniformInt(0, h - 1), t = rng.uniformInt(2, std::max(3, h / 10));
-      cv::rectangle(inner, cv::Rect(0, y, w, t), colour, cv::FILLED);
+      inner.rectangle(cv::Rect(0, y, w, t), colour, cv::FILLED);
     } else if (kind == 1) {
-      cv::circle(inner, cv::Point(rng.uniformInt(0, w - 1), rng.uniformInt(0, h - 1)),
-                 rng.uniformInt(3, std::max(4, w / 6)), colour, cv::FILLED, cv::LINE_AA);
+      inner.circle(cv::Point(rng.uniformInt(0, w - 1), rng.uniformInt(0, h - 1)),
+                   rng.uniformInt(3, std::max(4, w / 6)), colour, cv::FILLED, cv::LINE_AA);
     } else {  // "text": short dark bars in rows
       const int y = rng.uniformInt(0, h - 1), x = rng.uniformInt(0, w - 1);
-      cv::rectangle(inner, cv::Rect(x, y, rng.uniformInt(4, std::max(5, w / 3)), std::max(2, h / 25)),
-                    randomColour(rng, 0, 70), cv::FILLED);
+      inner.rectangle(cv::Rect(x, y, rng.uniformInt(4, std::max(5, w / 3)), std::max(2, h / 25)),
+                      randomColour(rng, 0, 70), cv::FILLED);
     }
   }
-  cv::rectangle(bgr, rect, randomColour(rng, 0, 60), std::max(2, static_cast<int>(0.015 * tpm)));
+  canvas.rectangle(rect, randomColour(rng, 0, 60), std::max(2, static_cast<int>(0.015 * tpm)));
 }
 
-void drawTiles(cv::Mat& bgr, double tpm, SplitMix64& rng) {
+void drawTiles(TextureCanvas& canvas, double tpm, SplitMix64& rng) {
   const int tile = static_cast<int>(rng.uniform(0.3, 0.5) * tpm);
   const cv::Scalar grout = randomColour(rng, 40, 110);
-  for (int y = 0; y < bgr.rows; y += tile)
-    for (int x = 0; x < bgr.cols; x += tile) {
+  for (int y = 0; y < canvas.rows; y += tile)
+    for (int x = 0; x < canvas.cols; x += tile) {
       const double gain = rng.uniform(0.85, 1.15);  // each tile its own shade
-      cv::Mat t = bgr(cv::Rect(x, y, std::min(tile, bgr.cols - x), std::min(tile, bgr.rows - y)));
-      t.convertTo(t, -1, gain);
+      canvas.scale(cv::Rect(x, y, std::min(tile, canvas.cols - x), std::min(tile, canvas.rows - y)), gain);
     }
-  for (int y = 0; y < bgr.rows; y += tile) cv::line(bgr, {0, y}, {bgr.cols - 1, y}, grout, 2, cv::LINE_AA);
-  for (int x = 0; x < bgr.cols; x += tile) cv::line(bgr, {x, 0}, {x, bgr.rows - 1}, grout, 2, cv::LINE_AA);
+  for (int y = 0; y < canvas.rows; y += tile) canvas.line({0, y}, {canvas.cols - 1, y}, grout, 2, cv::LINE_AA);
+  for (int x = 0; x < canvas.cols; x += tile) canvas.line({x, 0}, {x, canvas.rows - 1}, grout, 2, cv::LINE_AA);
 }
 
-void drawStripes(cv::Mat& bgr, double tpm, SplitMix64& rng) {
+void drawStripes(TextureCanvas& canvas, double tpm, SplitMix64& rng) {
   const int count = rng.uniformInt(2, 6);
   for (int i = 0; i < count; ++i) {
     const int t = std::max(2, static_cast<int>(rng.uniform(0.01, 0.05) * tpm));
     if (rng.uniform() < 0.5) {
-      const int y = rng.uniformInt(0, bgr.rows - 1);
-      cv::rectangle(bgr, cv::Rect(0, y, bgr.cols, t), randomColour(rng), cv::FILLED);
+      const int y = rng.uniformInt(0, canvas.rows - 1);
+      canvas.rectangle(cv::Rect(0, y, canvas.cols, t), randomColour(rng), cv::FILLED);
     } else {
-      const int x = rng.uniformInt(0, bgr.cols - 1);
-      cv::rectangle(bgr, cv::Rect(x, 0, t, bgr.rows), randomColour(rng), cv::FILLED);
+      const int x = rng.uniformInt(0, canvas.cols - 1);
+      canvas.rectangle(cv::Rect(x, 0, t, canvas.rows), randomColour(rng), cv::FILLED);
     }
   }
 }
 
 }  // namespace
 
-SurfaceTexture makeSurfaceTexture(double width_m, double height_m, double tpm, TextureStyle style,
-                                  const cv::Vec3f& base_bgr, SplitMix64& rng) {
-  SurfaceTexture texture;
-  texture.texels_per_metre = tpm;
-  const int cols = std::max(2, static_cast<int>(std::ceil(width_m * tpm)));
-  const int rows = std::max(2, static_cast<int>(std::ceil(height_m * tpm)));
-  texture.bgr.create(rows, cols, CV_8UC3);
-  texture.bgr.setTo(cv::Scalar(base_bgr[0], base_bgr[1], base_bgr[2]));
-  cv::Mat& bgr = texture.bgr;
+TextureRecipe planSurfaceTexture(double width_m, double height_m, double tpm, TextureStyle style,
+                                 const cv::Vec3f& base_bgr, SplitMix64& rng) {
+  TextureRecipe recipe = flatTextureRecipe(width_m, height_m, tpm, base_bgr);
+  TextureCanvas canvas(&recipe.ops, cv::Rect(0, 0, recipe.cols, recipe.rows));
   const double area_m2 = width_m * height_m;
   switch (style) {
     case TextureStyle::kWall:
-      drawBlobs(bgr, tpm, 10, 0.02, 0.10, rng);
-      for (int i = static_cast<int>(area_m2 / 4) + 1; i > 0; --i) drawPoster(bgr, tpm, rng);
-      for (int i = static_cast<int>(area_m2 / 6) + 1; i > 0; --i) drawCheckerPatch(bgr, tpm, rng);
+      drawBlobs(canvas, tpm, 10, 0.02, 0.10, rng);
+      for (int i = static_cast<int>(area_m2 / 4) + 1; i > 0; --i) drawPoster(canvas, tpm, rng);
+      for (int i = static_cast<int>(area_m2 / 6) + 1; i > 0; --i) drawCheckerPatch(canvas, tpm, rng);
       break;
     case TextureStyle::kFloor:
-      drawTiles(bgr, tpm, rng);
-      drawBlobs(bgr, tpm, 6, 0.015, 0.06, rng);
+      drawTiles(canvas, tpm, rng);
+      drawBlobs(canvas, tpm, 6, 0.015, 0.06, rng);
       break;
     case TextureStyle::kObject:
-      drawStripes(bgr, tpm, rng);
-      drawBlobs(bgr, tpm, 40, 0.01, 0.05, rng);
-      if (area_m2 > 0.1) drawCheckerPatch(bgr, tpm, rng);
+      drawStripes(canvas, tpm, rng);
+      drawBlobs(canvas, tpm, 40, 0.01, 0.05, rng);
+      if (area_m2 > 0.1) drawCheckerPatch(canvas, tpm, rng);
       break;
     case TextureStyle::kRug:
-      drawCheckerPatch(bgr, tpm, rng);
-      drawBlobs(bgr, tpm, 25, 0.03, 0.12, rng);
+      drawCheckerPatch(canvas, tpm, rng);
+      drawBlobs(canvas, tpm, 25, 0.03, 0.12, rng);
       break;
     case TextureStyle::kCeiling:
       break;
   }
-  applyLowFrequencyShading(bgr, tpm, rng);
-  // Band-limit: no detail finer than ~2 texels, so distant views do not alias.
-  cv::GaussianBlur(bgr, bgr, cv::Size(0, 0), 0.7);
-  return texture;
+  drawLowFrequencyShading(recipe, tpm, rng);
+  return recipe;
 }
 
 }  // namespace plumb::synth

@@ -78,7 +78,8 @@ class SyntheticSceneImpl;
 
 class SyntheticScene {
  public:
-  // Builds the room, its textures and the camera path (a few hundred ms at most).
+  // Builds the room, its texture recipes and the camera path (~1 ms); a face's texture is painted
+  // when a frame first shows it.
   static Status create(const SynthOptions& options, std::unique_ptr<SyntheticScene>* out);
   ~SyntheticScene();
 
@@ -92,7 +93,8 @@ class SyntheticScene {
   Eigen::Isometry3d T_world_cam(int i) const;
   // Renders frame i into `out` (bgr CV_8UC3, depth_raw CV_16UC1, timestamps, depth_factor).
   // Reuses out's buffers when their size and type match, so steady-state rendering does not
-  // allocate. Deterministic: the bytes depend only on the options and i. Not safe to call
+  // allocate (once every face in view has been painted). Deterministic: the bytes depend only on
+  // the options and i, not on the frames rendered before. Not safe to call
   // concurrently on one scene (it uses the scene's scratch buffers); use one scene per thread.
   Status render(int i, RgbdImage& out) const;
 

@@ -13,15 +13,9 @@
 
 #include "drivers/common/atomic_file.h"
 #include "platform/status.h"
+#include "sensor/stamped_pose.h"
 
 namespace plumb {
-
-struct StampedPose {
-  double timestamp = 0;
-  Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
-  bool valid = true;  // false: the frame had no pose (written as `# <timestamp> lost`)
-  bool dropped = false;  // with !valid: the frame was never processed (real-time drop), `# <timestamp> dropped`
-};
 
 struct TrajectoryReadOptions {
   // A quaternion whose norm is within this of 1 is normalised (files print 4-9 digits); further

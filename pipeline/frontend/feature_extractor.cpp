@@ -1,26 +1,16 @@
 #include "pipeline/frontend/feature_extractor.h"
 
 #include <algorithm>
-#include <chrono>
-#include <ctime>
 
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/frontend/depth_sampler.h"
 #include "pipeline/frontend/line_extractor.h"
 #include "pipeline/frontend/orb_extractor.h"
+#include "platform/stage_timing.h"
 
 namespace plumb {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
-
-double threadCpuMs() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
 
 // Undistorted-pixel bounds of the whole raw image (barrel distortion pushes them outside
 // [0,w)x[0,h)), found by undistorting points along the border.
@@ -59,7 +49,7 @@ FeatureExtractor::FeatureExtractor(const PinholeCamera& camera, const ExtractorO
 FeatureExtractor::~FeatureExtractor() = default;
 
 bool FeatureExtractor::extract(const RgbdImage& in, FrameFeatures& out) {
-  const auto t_start = Clock::now();
+  const auto t_start = StageClock::now();
   const double cpu_start = threadCpuMs();
   out.clear();
   timings_ = ExtractorTimings();
@@ -73,21 +63,21 @@ bool FeatureExtractor::extract(const RgbdImage& in, FrameFeatures& out) {
     in.bgr.copyTo(grey_);
   }
 
-  const auto t_orb = Clock::now();
+  const auto t_orb = StageClock::now();
   const double cpu_orb = threadCpuMs();
   orb_->extract(grey_, out);
   timings_.orb_ms = msSince(t_orb);
   timings_.orb_cpu_ms = threadCpuMs() - cpu_orb;
   timings_.pyramid_ms = orb_->lastPyramidMs();
 
-  const auto t_lines = Clock::now();
+  const auto t_lines = StageClock::now();
   const double cpu_lines = threadCpuMs();
   lines_->extract(orb_->pyramid(), out);
   timings_.lines_ms = msSince(t_lines);
   timings_.lines_cpu_ms = threadCpuMs() - cpu_lines;
   timings_.lsd_raw_segments = lines_->lastRawSegments();
 
-  const auto t_depth = Clock::now();
+  const auto t_depth = StageClock::now();
   const double cpu_depth = threadCpuMs();
   const bool depth_ok = !in.depth_raw.empty() && in.depth_raw.type() == CV_16UC1 &&
                         in.depth_raw.cols == camera_.width && in.depth_raw.rows == camera_.height;

@@ -14,6 +14,7 @@
 #include <Eigen/Geometry>
 
 #include "pipeline/odometry/local_map.h"
+#include "sensor/stamped_pose.h"
 
 namespace plumb {
 
@@ -28,6 +29,16 @@ struct FinishedFrame {
   uint32_t reference_id = 0;
   Eigen::Isometry3d T_ref_cam = Eigen::Isometry3d::Identity();
 };
+
+// The frame as a trajectory sample: what trajectory files, the tools and the API keep of it.
+inline StampedPose toStampedPose(const FinishedFrame& frame) {
+  StampedPose pose;
+  pose.timestamp = frame.timestamp_s;
+  pose.T_world_cam = frame.T_world_cam;
+  pose.valid = frame.valid;
+  pose.dropped = frame.dropped;
+  return pose;
+}
 
 class OdometryTrajectory {
  public:

@@ -8,52 +8,20 @@
 //     independently, to the raw camera pose T_world_cam: default forward camera, so
 //     position_local = (cam z, cam x, cam y) and quaternion (w, x, y, z) -> (w, z, x, y).
 // Usage: node decode_check.js --sender BINARY --frames N --expected FILE
-const dgram = require('dgram');
 const fs = require('fs');
 const { spawn } = require('child_process');
+const shared = require('./mavlink_capture');
 
-let mav;
-try {
-  mav = require('node-mavlink');
-} catch (e) {
-  console.log('SKIP mavlink_node_decode: cannot load node-mavlink (' + e.message + ')');
-  process.exit(77);
-}
-const { MavLinkPacketSplitter, MavLinkPacketParser, minimal, common } = mav;
-const REGISTRY = { ...minimal.REGISTRY, ...common.REGISTRY };
+const mav = shared.loadMavlink('mavlink_node_decode');
+const { common } = mav;
+const args = shared.parseArgs(['sender', 'expected'], 'node decode_check.js --sender BINARY --frames N --expected FILE');
 
-const args = {};
-for (let i = 2; i + 1 < process.argv.length; i += 2) args[process.argv[i].replace(/^--/, '')] = process.argv[i + 1];
-if (!args.sender || !args.expected) {
-  console.error('usage: node decode_check.js --sender BINARY --frames N --expected FILE');
-  process.exit(2);
-}
-
-let crcErrors = 0;
-const splitter = new MavLinkPacketSplitter({}, { onCrcError: () => { crcErrors++; } });
-const parser = splitter.pipe(new MavLinkPacketParser());
-const odometry = [];
-const heartbeats = [];
-const failures = [];
-parser.on('data', (packet) => {
-  const clazz = REGISTRY[packet.header.msgid];
-  if (!clazz) { failures.push('unknown msgid ' + packet.header.msgid); return; }
-  const data = packet.protocol.data(packet.payload, clazz);
-  if (packet.header.msgid === 331) odometry.push({ header: packet.header, data });
-  else if (packet.header.msgid === 0) heartbeats.push({ header: packet.header, data });
-  else failures.push('unexpected msgid ' + packet.header.msgid);
-});
-
-const socket = dgram.createSocket('udp4');
-socket.on('message', (msg) => splitter.write(msg));
-socket.bind(0, '127.0.0.1', () => {
-  const port = socket.address().port;
-  const child = spawn(args.sender, ['--endpoint', `udp:127.0.0.1:${port}`, '--frames', args.frames || '250',
-    '--rate-hz', '1000', '--expected', args.expected], { stdio: ['ignore', 'inherit', 'inherit'] });
-  child.on('exit', (code) => {
-    if (code !== 0) { console.error('sender failed with exit code ' + code); process.exit(1); }
-    setTimeout(() => { socket.close(); splitter.end(); setImmediate(check); }, 500);
-  });
+shared.captureFromSender({
+  mav,
+  senderName: 'sender',
+  startSender: (port) => spawn(args.sender, ['--endpoint', `udp:127.0.0.1:${port}`, '--frames', args.frames || '250',
+    '--rate-hz', '1000', '--expected', args.expected], { stdio: ['ignore', 'inherit', 'inherit'] }),
+  check,
 });
 
 function sameFloat32(decoded, expectedText) {
@@ -62,10 +30,10 @@ function sameFloat32(decoded, expectedText) {
   return Math.fround(e) === decoded;
 }
 
-function check() {
+function check(capture) {
+  const { odometry, heartbeats, crcErrors } = capture;
+  const failures = capture.failures.concat(shared.streamFailures(capture));
   const lines = fs.readFileSync(args.expected, 'utf8').split('\n').filter((l) => l && !l.startsWith('#'));
-  if (crcErrors) failures.push(crcErrors + ' CRC errors');
-  if (splitter.invalidPackages) failures.push(splitter.invalidPackages + ' invalid packets');
   if (odometry.length !== lines.length) failures.push(`decoded ${odometry.length} ODOMETRY, sender wrote ${lines.length}`);
   if (heartbeats.length < 1) failures.push('no HEARTBEAT');
   for (const hb of heartbeats) {
@@ -80,10 +48,8 @@ function check() {
     const f = lines[i].trim().split(/\s+/);
     const { header, data: d } = odometry[i];
     const where = `message ${i} (frame ${f[0]})`;
-    if (header.sysid !== 1 || header.compid !== 197) failures.push(where + ': sysid/compid');
+    failures.push(...shared.odometryHeaderFailures(common, header, d, where));
     if (header.payloadLength > 233) failures.push(where + ': payload length ' + header.payloadLength);
-    if (d.frameId !== common.MavFrame.LOCAL_FRD || d.childFrameId !== common.MavFrame.BODY_FRD) failures.push(where + ': frames');
-    if (d.estimatorType !== common.MavEstimatorType.VISION) failures.push(where + ': estimator_type');
     if (String(d.timeUsec) !== f[8]) failures.push(`${where}: time_usec ${d.timeUsec} != ${f[8]}`);
     // Exact comparison with what the sender wrote.
     const decoded = [d.x, d.y, d.z, ...d.q, d.vx, d.vy, d.vz, d.rollspeed, d.pitchspeed, d.yawspeed];
@@ -99,11 +65,9 @@ function check() {
     if (!Number.isNaN(d.velocityCovariance[0])) failures.push(where + ': velocity covariance should be unknown (NaN)');
     // Independent frame change from the raw camera pose.
     const [tx, ty, tz, qw, qx, qy, qz] = f.slice(1, 8).map(Number);
-    const pos = [tz, tx, ty];
+    const { pos, quat } = shared.frameChanged([tx, ty, tz], [qw, qx, qy, qz], d.q);
     const pd = [d.x, d.y, d.z];
     for (let j = 0; j < 3; j++) maxPosErr = Math.max(maxPosErr, Math.abs(pd[j] - pos[j]));
-    let quat = [qw, qz, qx, qy];
-    if (quat[0] * d.q[0] + quat[1] * d.q[1] + quat[2] * d.q[2] + quat[3] * d.q[3] < 0) quat = quat.map((v) => -v);
     for (let j = 0; j < 4; j++) maxQuatErr = Math.max(maxQuatErr, Math.abs(d.q[j] - quat[j]));
   }
   // float32 has a 24-bit mantissa: positions up to ~10 m carry <= ~5e-7 m rounding.
@@ -112,9 +76,5 @@ function check() {
   console.log(`mavlink_node_decode: node-mavlink decoded ${odometry.length} ODOMETRY + ${heartbeats.length} HEARTBEAT, ` +
     `${crcErrors} CRC errors; ${exactFields} float fields equal as float32; ` +
     `max |position - frame-changed trajectory| = ${maxPosErr.toExponential(2)} m, max |q diff| = ${maxQuatErr.toExponential(2)}`);
-  if (failures.length) {
-    console.log('FAILED: ' + failures.length + ' problems, first: ' + failures.slice(0, 10).join('; '));
-    process.exit(1);
-  }
-  process.exit(0);
+  shared.finish(failures);
 }

@@ -12,60 +12,30 @@
 //     pose, and the first after a reset or a lost stretch, docs/MAVLINK.md);
 //   - time_usec = round(t * 1e6) of the frame's line.
 // Usage: node decode_run_check.js --plumb BINARY --dataset SPEC --frames N --work DIR
-const dgram = require('dgram');
 const fs = require('fs');
 const path = require('path');
 const { spawn } = require('child_process');
+const shared = require('./mavlink_capture');
 
-let mav;
-try {
-  mav = require('node-mavlink');
-} catch (e) {
-  console.log('SKIP mavlink_node_run: cannot load node-mavlink (' + e.message + ')');
-  process.exit(77);
-}
-const { MavLinkPacketSplitter, MavLinkPacketParser, minimal, common } = mav;
-const REGISTRY = { ...minimal.REGISTRY, ...common.REGISTRY };
-
-const args = {};
-for (let i = 2; i + 1 < process.argv.length; i += 2) args[process.argv[i].replace(/^--/, '')] = process.argv[i + 1];
-if (!args.plumb || !args.dataset || !args.work) {
-  console.error('usage: node decode_run_check.js --plumb BINARY --dataset SPEC --frames N --work DIR');
-  process.exit(2);
-}
+const mav = shared.loadMavlink('mavlink_node_run');
+const { common } = mav;
+const args = shared.parseArgs(['plumb', 'dataset', 'work'],
+  'node decode_run_check.js --plumb BINARY --dataset SPEC --frames N --work DIR');
 const trajectoryPath = path.join(args.work, 'traj.txt');
 
-let crcErrors = 0;
-const splitter = new MavLinkPacketSplitter({}, { onCrcError: () => { crcErrors++; } });
-const parser = splitter.pipe(new MavLinkPacketParser());
-const odometry = [];
-const heartbeats = [];
-const sequences = [];
-const failures = [];
-parser.on('data', (packet) => {
-  sequences.push(packet.header.seq);
-  const clazz = REGISTRY[packet.header.msgid];
-  if (!clazz) { failures.push('unknown msgid ' + packet.header.msgid); return; }
-  const data = packet.protocol.data(packet.payload, clazz);
-  if (packet.header.msgid === 331) odometry.push({ header: packet.header, data });
-  else if (packet.header.msgid === 0) heartbeats.push({ header: packet.header, data });
-  else failures.push('unexpected msgid ' + packet.header.msgid);
-});
-
 let plumbOutput = '';
-const socket = dgram.createSocket('udp4');
-socket.on('message', (msg) => splitter.write(msg));
-socket.bind(0, '127.0.0.1', () => {
-  const port = socket.address().port;
-  const child = spawn(args.plumb, ['run', '--dataset', args.dataset, '--max-frames', args.frames || '250',
-    '--mavlink', `udp:127.0.0.1:${port}`, '--out', trajectoryPath, '--output-delay', '0'],
-  { stdio: ['ignore', 'pipe', 'inherit'] });
-  child.stdout.on('data', (d) => { plumbOutput += d; });
-  child.on('exit', (code) => {
-    process.stdout.write(plumbOutput);
-    if (code !== 0) { console.error('plumb run failed with exit code ' + code); process.exit(1); }
-    setTimeout(() => { socket.close(); splitter.end(); setImmediate(check); }, 500);
-  });
+shared.captureFromSender({
+  mav,
+  senderName: 'plumb run',
+  startSender: (port) => {
+    const child = spawn(args.plumb, ['run', '--dataset', args.dataset, '--max-frames', args.frames || '250',
+      '--mavlink', `udp:127.0.0.1:${port}`, '--out', trajectoryPath, '--output-delay', '0'],
+    { stdio: ['ignore', 'pipe', 'inherit'] });
+    child.stdout.on('data', (d) => { plumbOutput += d; });
+    return child;
+  },
+  onSenderExit: () => process.stdout.write(plumbOutput),
+  check,
 });
 
 // |decoded - value| within float32 rounding of the value plus the file's 9-digit rounding.
@@ -73,7 +43,9 @@ function closeAsFloat(decoded, value) {
   return Math.abs(decoded - value) <= Math.abs(value) * (Math.pow(2, -24) + 1e-8) + 1e-12;
 }
 
-function check() {
+function check(capture) {
+  const { odometry, heartbeats, sequences, crcErrors } = capture;
+  const failures = capture.failures.concat(shared.streamFailures(capture));
   const lines = fs.readFileSync(trajectoryPath, 'utf8').split('\n').filter((l) => l);
   const frames = [];  // {usec, valid, pose}
   for (const l of lines) {
@@ -85,8 +57,6 @@ function check() {
     frames.push({ usec: Math.round(Number(f[0]) * 1e6), valid: true, v: f.slice(1, 8).map(Number) });
   }
   const byUsec = new Map(frames.map((fr, i) => [fr.usec, i]));
-  if (crcErrors) failures.push(crcErrors + ' CRC errors');
-  if (splitter.invalidPackages) failures.push(splitter.invalidPackages + ' invalid packets');
   for (let i = 1; i < sequences.length; i++) {
     if (sequences[i] !== ((sequences[i - 1] + 1) & 255)) { failures.push('sequence gap at packet ' + i); break; }
   }
@@ -107,15 +77,11 @@ function check() {
     previousReset = d.resetCounter;
     const fr = frames[k];
     if (!fr.valid) { failures.push(where + ': sent for a frame the trajectory marks lost'); continue; }
-    if (header.sysid !== 1 || header.compid !== 197) failures.push(where + ': sysid/compid');
-    if (d.frameId !== common.MavFrame.LOCAL_FRD || d.childFrameId !== common.MavFrame.BODY_FRD) failures.push(where + ': frames');
-    if (d.estimatorType !== common.MavEstimatorType.VISION) failures.push(where + ': estimator_type');
+    failures.push(...shared.odometryHeaderFailures(common, header, d, where));
     if (!(d.quality >= 0 && d.quality <= 100)) failures.push(where + ': quality ' + d.quality);
     const [tx, ty, tz, qx, qy, qz, qw] = fr.v;
-    const pos = [tz, tx, ty];
+    const { pos, quat } = shared.frameChanged([tx, ty, tz], [qw, qx, qy, qz], d.q);
     const pd = [d.x, d.y, d.z];
-    let quat = [qw, qz, qx, qy];
-    if (quat[0] * d.q[0] + quat[1] * d.q[1] + quat[2] * d.q[2] + quat[3] * d.q[3] < 0) quat = quat.map((v) => -v);
     const expected = pos.concat(quat), decoded = pd.concat(Array.from(d.q));
     for (let j = 0; j < 7; j++) {
       compared++;
@@ -140,9 +106,5 @@ function check() {
     `${exactAsFloat}/${compared} position/quaternion fields equal float32(file value); ` +
     `max |position - file| = ${maxPosErr.toExponential(2)} m, max |q - file| = ${maxQuatErr.toExponential(2)}`);
   if (odometry.length === 0) failures.push('nothing decoded');
-  if (failures.length) {
-    console.log('FAILED: ' + failures.length + ' problems, first: ' + failures.slice(0, 10).join('; '));
-    process.exit(1);
-  }
-  process.exit(0);
+  shared.finish(failures);
 }

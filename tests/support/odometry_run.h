@@ -14,6 +14,7 @@
 #include "drivers/synth/synthetic_scene.h"
 #include "drivers/trajectory/evaluate.h"
 #include "drivers/trajectory/trajectory_io.h"
+#include "pipeline/odometry/odometry_trajectory.h"
 #include "pipeline/run/odometry_run.h"
 
 namespace plumb::test {
@@ -47,12 +48,7 @@ class CollectingSink final : public OdometrySink {
     return Status::Ok();
   }
   Status onFinishedFrame(const FinishedFrame& f) override {
-    StampedPose p;
-    p.timestamp = f.timestamp_s;
-    p.T_world_cam = f.T_world_cam;
-    p.valid = f.valid;
-    p.dropped = f.dropped;
-    run_->trajectory.push_back(p);
+    run_->trajectory.push_back(toStampedPose(f));
     run_->references.emplace_back(f.reference_id, f.T_ref_cam);
     return Status::Ok();
   }

@@ -1,0 +1,49 @@
+// Textures painted on first use (see baked_textures.h).
+#include "drivers/synth/baked_textures.h"
+
+#include <algorithm>
+
+#include "drivers/synth/light_baking.h"
+
+namespace plumb::synth {
+
+namespace {
+
+constexpr size_t kAlignment = 64;  // each texture starts on a cache line
+
+size_t aligned(size_t bytes) { return (bytes + kAlignment - 1) & ~(kAlignment - 1); }
+
+size_t textureBytes(const TextureRecipe& recipe) { return aligned(static_cast<size_t>(recipe.rows) * recipe.cols * 3); }
+
+}  // namespace
+
+BakedTextures::BakedTextures(const SceneModel& model) : model_(model), textures_(model.textures.size()) {
+  size_t canvas_bytes = 0, gain_bytes = 0, texture_bytes = 0;
+  for (const TextureRecipe& recipe : model.textures) {
+    canvas_bytes = std::max(canvas_bytes, aligned(PaintScratch::canvasBytes(recipe)));
+    gain_bytes = std::max(gain_bytes, aligned(PaintScratch::gainBytes(recipe)));
+    texture_bytes += textureBytes(recipe);
+    light_scratch_.reserve(recipe.cols);
+  }
+  memory_ = HugePageBuffer(canvas_bytes + gain_bytes + texture_bytes);
+  if (!memory_.data()) return;  // no block: painting allocates as it goes
+  if (canvas_bytes) scratch_.canvas = cv::Mat(1, static_cast<int>(canvas_bytes), CV_8U, memory_.data());
+  if (gain_bytes) scratch_.gain = cv::Mat(1, static_cast<int>(gain_bytes), CV_8U, memory_.data() + canvas_bytes);
+  memory_used_ = canvas_bytes + gain_bytes;
+}
+
+void BakedTextures::prepare(int quad_index) {
+  const SceneQuad& quad = model_.quads[quad_index];
+  SurfaceTexture& texture = textures_[quad.texture];
+  if (!texture.bgr.empty()) return;
+  const TextureRecipe& recipe = model_.textures[quad.texture];
+  if (memory_.data()) {
+    texture.bgr = cv::Mat(recipe.rows, recipe.cols, CV_8UC3, memory_.data() + memory_used_);
+    memory_used_ += textureBytes(recipe);
+  }
+  paintTexture(recipe, scratch_, texture.bgr);
+  bakeLighting(model_, quad, recipe.texels_per_metre, texture.bgr, light_scratch_);
+  texture.texels_per_metre = recipe.texels_per_metre;
+}
+
+}  // namespace plumb::synth

@@ -1,0 +1,47 @@
+#pragma once
+// The painted, lit textures of a scene's quads, made when a frame first needs them and kept.
+//
+// Painting and lighting every face up front cost ~1.5 G instructions (~150 ms) before the first
+// frame, most of it on faces that frame does not see. A texture depends only on its recipe and its
+// quad (never on when it is painted or what was painted before), so painting on first use gives
+// the same texels, and so the same frames, as painting everything at once. Not thread-safe: it
+// belongs to one FrameRenderer, which is itself used by one thread at a time.
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "drivers/synth/light_baking.h"
+#include "drivers/synth/scene_model.h"
+#include "platform/huge_page_buffer.h"
+
+namespace plumb::synth {
+
+// A texture covers its quad exactly: texel (x, y) <-> (u, v) = ((x + 0.5), (y + 0.5)) / texels_per_metre.
+struct SurfaceTexture {
+  cv::Mat bgr;  // CV_8UC3, lighting baked in; empty until painted
+  double texels_per_metre = 0;
+};
+
+class BakedTextures {
+ public:
+  // Keeps a reference to model (it must outlive this); reserves memory for every texture but
+  // paints nothing yet.
+  explicit BakedTextures(const SceneModel& model);
+
+  // Paints and lights quad_index's texture unless that is done already.
+  void prepare(int quad_index);
+  // The texture of a prepared quad.
+  const SurfaceTexture& texture(int quad_index) const { return textures_[model_.quads[quad_index].texture]; }
+
+ private:
+  const SceneModel& model_;
+  std::vector<SurfaceTexture> textures_;  // indexed like model.textures
+  // One block for every texture and the painting scratch, sized at construction: textures are
+  // handed out from it as they are painted (huge pages: few page faults; see huge_page_buffer.h).
+  HugePageBuffer memory_;
+  size_t memory_used_ = 0;
+  PaintScratch scratch_;
+  LightScratch light_scratch_;
+};
+
+}  // namespace plumb::synth
