@@ -183,7 +183,7 @@ std::size_t KeyframeDatabase::memoryBytesFor(const KeyframeDatabaseOptions& o) {
   const std::size_t words = std::size_t(2) << o.bits_per_word;
   const std::size_t keyframes = std::size_t(o.max_keyframes);
   const std::size_t descriptors = std::size_t(o.max_point_descriptors + o.max_line_descriptors);
-  return sizeof(KeyframeDatabase) + words * 2 * sizeof(uint32_t) +
+  return sizeof(KeyframeDatabase) + words * (sizeof(uint32_t) + sizeof(uint16_t)) +
          std::size_t(o.max_postings) * sizeof(Posting) +
          keyframes * (sizeof(KeyframeSlot) + sizeof(uint32_t) /*free_slots_*/ + 2 * sizeof(double) +
                       sizeof(uint32_t) + sizeof(uint8_t) + sizeof(Scored)) +
@@ -192,7 +192,7 @@ std::size_t KeyframeDatabase::memoryBytesFor(const KeyframeDatabaseOptions& o) {
 
 std::size_t KeyframeDatabase::memoryBytes() const {
   return sizeof(*this) + word_head_.capacity() * sizeof(uint32_t) +
-         word_keyframes_.capacity() * sizeof(uint32_t) + postings_.capacity() * sizeof(Posting) +
+         word_keyframes_.capacity() * sizeof(uint16_t) + postings_.capacity() * sizeof(Posting) +
          slots_.capacity() * sizeof(KeyframeSlot) + free_slots_.capacity() * sizeof(uint32_t) +
          word_values_scratch_.capacity() * sizeof(uint32_t) + words_scratch_.capacity() * sizeof(WordCount) +
          (accumulator_[0].capacity() + accumulator_[1].capacity()) * sizeof(double) +

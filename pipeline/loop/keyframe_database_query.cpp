@@ -28,7 +28,7 @@ std::size_t KeyframeDatabase::histogram(const PlaceDescriptors& descriptors) {
 }
 
 double KeyframeDatabase::idf(uint32_t word) const {
-  const double n_w = std::max<uint32_t>(word_keyframes_[word], 1u);
+  const double n_w = std::max<uint32_t>(uint32_t(word_keyframes_[word]), 1u);
   return std::log(1.0 + double(num_keyframes_) / n_w);
 }
 
