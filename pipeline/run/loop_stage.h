@@ -75,7 +75,7 @@ class LoopStage {
   const bool threaded_;
   const int thread_nice_;
   std::unique_ptr<loop::LoopKeyframe> made_;    // map stage thread
-  std::unique_ptr<loop::LoopKeyframe> popped_;  // loop thread
+  std::unique_ptr<loop::LoopKeyframe> popped_;  // loop thread (threaded modes only)
   runtime::SpscRing<loop::LoopKeyframe> ring_;
   runtime::SpscRing<FinalPose> final_ring_;
   bool synchronous_;  // deterministic mode, or after finish()
