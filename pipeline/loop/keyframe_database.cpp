@@ -28,7 +28,6 @@ KeyframeDatabase::KeyframeDatabase(const KeyframeDatabaseOptions& options) : opt
   assert(validate(options).ok());
   num_words_total_ = std::size_t(2) << options.bits_per_word;
   word_head_.assign(num_words_total_, kNone);
-  word_keyframes_.assign(num_words_total_, 0);
   postings_.resize(std::size_t(options.max_postings));
   // Free postings chained in index order, so the first insert uses postings 0, 1, 2, ...
   for (std::size_t i = 0; i < postings_.size(); ++i)
@@ -117,7 +116,6 @@ Status KeyframeDatabase::insertHistogram(uint64_t keyframe_id, const WordCount* 
     posting.slot = uint16_t(slot_index);
     posting.next_in_word = word_head_[posting.word];
     word_head_[posting.word] = p;
-    ++word_keyframes_[posting.word];
     posting.next_in_keyframe = kNone;
     *link = p;
     link = &posting.next_in_keyframe;
@@ -139,7 +137,6 @@ Status KeyframeDatabase::remove(uint64_t keyframe_id) {
     uint32_t* link = &word_head_[posting.word];
     while (*link != p) link = &postings_[*link].next_in_word;
     *link = posting.next_in_word;
-    --word_keyframes_[posting.word];
     posting.next_in_word = kNone;
     posting.next_in_keyframe = free_posting_head_;
     free_posting_head_ = p;
@@ -183,7 +180,7 @@ std::size_t KeyframeDatabase::memoryBytesFor(const KeyframeDatabaseOptions& o) {
   const std::size_t words = std::size_t(2) << o.bits_per_word;
   const std::size_t keyframes = std::size_t(o.max_keyframes);
   const std::size_t descriptors = std::size_t(o.max_point_descriptors + o.max_line_descriptors);
-  return sizeof(KeyframeDatabase) + words * (sizeof(uint32_t) + sizeof(uint16_t)) +
+  return sizeof(KeyframeDatabase) + words * sizeof(uint32_t) +
          std::size_t(o.max_postings) * sizeof(Posting) +
          keyframes * (sizeof(KeyframeSlot) + sizeof(uint32_t) /*free_slots_*/ + 2 * sizeof(double) +
                       sizeof(uint32_t) + sizeof(uint8_t) + sizeof(Scored)) +
@@ -192,7 +189,7 @@ std::size_t KeyframeDatabase::memoryBytesFor(const KeyframeDatabaseOptions& o) {
 
 std::size_t KeyframeDatabase::memoryBytes() const {
   return sizeof(*this) + word_head_.capacity() * sizeof(uint32_t) +
-         word_keyframes_.capacity() * sizeof(uint16_t) + postings_.capacity() * sizeof(Posting) +
+         postings_.capacity() * sizeof(Posting) +
          slots_.capacity() * sizeof(KeyframeSlot) + free_slots_.capacity() * sizeof(uint32_t) +
          word_values_scratch_.capacity() * sizeof(uint32_t) + words_scratch_.capacity() * sizeof(WordCount) +
          (accumulator_[0].capacity() + accumulator_[1].capacity()) * sizeof(double) +

@@ -162,7 +162,6 @@ class KeyframeDatabase {
   std::size_t num_words_total_ = 0;  // 2 * 2^K
 
   std::vector<uint32_t> word_head_;       // per word: first posting, kNone if empty
-  std::vector<uint16_t> word_keyframes_;  // per word: n_w, keyframes containing it (<= max_keyframes <= 65535)
   std::vector<Posting> postings_;
   uint32_t free_posting_head_ = kNone;  // free postings chained through next_in_keyframe
   std::size_t free_postings_ = 0;

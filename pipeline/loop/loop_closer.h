@@ -41,7 +41,7 @@ namespace plumb::loop {
 
 struct LoopCloserOptions {
   int capacity = 128;          // keyframe records = database entries = graph nodes (docs/LOOP.md "Memory")
-  int max_loop_edges = 32;     // the oldest loop edge is forgotten when full
+  int max_loop_edges = 24;     // the oldest loop edge is forgotten when full
   int min_age_keyframes = 40;  // candidate id <= query id - this (the local map holds 32)
   int candidates = 10;         // database results per query
   double min_candidate_score = 0.02;
