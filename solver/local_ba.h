@@ -221,7 +221,9 @@ class LocalBundleAdjuster {
 
   CameraIntrinsics camera_;
   std::vector<Keyframe> keyframes_;
-  std::vector<Landmark> landmarks_;
+  // Zero pages as for the observations below: all-zero bytes ARE a default Landmark (zero
+  // matrices, counts 0, false), so this only defers residency to the first BA that reaches a slot.
+  std::vector<Landmark, ZeroPageAllocator<Landmark>> landmarks_;
   // Reserved for the worst case, written from the front: untouched slots stay out of RSS.
   std::vector<Observation, ZeroPageAllocator<Observation>> observations_;
   std::vector<int> observation_order_;  // observation indices grouped by landmark

@@ -64,15 +64,28 @@ PoseGraph::PoseGraph(int max_nodes, int max_edges)
   variable_node_.resize(max_nodes_);
 }
 
+Eigen::Index PoseGraph::chainFactorEntries(int max_nodes, int max_extra_edges) {
+  // Natural order, chain k -> k+1 plus extra edges. Eliminating block column k links the rows it
+  // holds, all after k, so by induction column k holds row k+1 and the far ends j > k of the
+  // extra edges (i, j) with i <= k < j: at most 1 + E blocks, and never more than the n - 1 - k
+  // block rows below it. 15 strictly-lower entries inside each diagonal block, 36 per block.
+  const Eigen::Index n = std::max(0, max_nodes);
+  const Eigen::Index per_column = 1 + std::max(0, max_extra_edges);
+  Eigen::Index entries = 0;
+  for (Eigen::Index k = 0; k < n; ++k) entries += 15 + 36 * std::min(per_column, n - 1 - k);
+  return entries;
+}
+
 void PoseGraph::reserveChainWithExtraEdges(int max_extra_edges) {
   natural_order_ = true;
   const Eigen::Index dim = 6 * Eigen::Index(max_nodes_);
-  const Eigen::Index blocks_per_column = 1 + std::max(0, max_extra_edges);
   // H: 21 entries per diagonal block, 36 per off-diagonal block (one per edge at most).
   H_.resize(dim, dim);
-  H_.resizeNonZeros(21 * Eigen::Index(max_nodes_) + 36 * Eigen::Index(max_edges_));
-  // L (strictly lower, column-wise): 15 within each diagonal block and 36 per fill block.
-  factorization_.reserveFactor(dim, Eigen::Index(max_nodes_) * (15 + 36 * blocks_per_column));
+  const Eigen::Index h_entries = 21 * Eigen::Index(max_nodes_) + 36 * Eigen::Index(max_edges_);
+  H_.resizeNonZeros(h_entries);
+  std::fill(H_.valuePtr(), H_.valuePtr() + h_entries, 0.0);  // resident from now on (header)
+  std::fill(H_.innerIndexPtr(), H_.innerIndexPtr() + h_entries, 0);
+  factorization_.reserveFactor(dim, chainFactorEntries(max_nodes_, max_extra_edges));
 }
 
 void PoseGraph::clear() {

@@ -49,6 +49,7 @@
 // A second optimize() on an unchanged structure makes zero calls to malloc, which is what Eigen
 // allocates with (tests/solver/malloc replaces malloc to prove it; an operator-new hook would not
 // see Eigen's allocations).
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -120,8 +121,13 @@ class PoseGraph {
   // fills little) and H and the factor get storage for that bound here, once, so a later analyze()
   // makes no operator-new allocation (Eigen's sparse arrays are new[]; the outer index arrays
   // and small dense vectors it still sizes use malloc). A graph beyond the bound still works
-  // (Eigen reallocates).
+  // (Eigen reallocates). The reserved arrays are written here (zeros), so they are resident from
+  // the start: a long run's memory does not grow as loops fill the factor.
   void reserveChainWithExtraEdges(int max_extra_edges);
+  // The factor entries reserveChainWithExtraEdges() reserves: the most a chain of max_nodes with
+  // max_extra_edges extra edges can fill in the natural order (derivation in the .cpp; tight when
+  // every extra edge spans the whole chain). H and the factor cost 12 bytes an entry.
+  static Eigen::Index chainFactorEntries(int max_nodes, int max_extra_edges);
 
   int maxNodes() const { return max_nodes_; }
   int maxEdges() const { return max_edges_; }
@@ -190,6 +196,9 @@ class PoseGraph {
     void reserveFactor(Eigen::Index size, Eigen::Index nnz) {
       m_matrix.resize(size, size);
       m_matrix.resizeNonZeros(nnz);
+      // Written once so the pages are resident now, not when a long run's loops fill the factor.
+      std::fill(m_matrix.valuePtr(), m_matrix.valuePtr() + nnz, 0.0);
+      std::fill(m_matrix.innerIndexPtr(), m_matrix.innerIndexPtr() + nnz, 0);
     }
     void factorizeOrdered(const Eigen::SparseMatrix<double>& H_upper) { factorize_preordered<true>(H_upper); }
     // analyzePattern() without its copy of the input into a temporary (new[] every call): the

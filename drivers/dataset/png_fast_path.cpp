@@ -9,13 +9,15 @@
 
 namespace plumb {
 
-namespace {
-
-// Grows a scratch buffer with 50 % headroom: compressed sizes vary from frame to frame, and a
-// buffer sized to the largest so far would reallocate whenever a later frame beats it.
-void ensureSize(std::vector<uint8_t>* buffer, std::size_t needed) {
-  if (buffer->size() < needed) buffer->resize(needed + needed / 2);
+// Grows with 50 % headroom: compressed sizes vary from frame to frame, and a buffer sized to the
+// largest so far would reallocate whenever a later frame beats it. Contents are not kept.
+void PngFastPath::Scratch::ensure(std::size_t needed) {
+  if (size >= needed) return;
+  size = needed + needed / 2;
+  bytes.reset(new uint8_t[size]);  // default-initialised: untouched pages stay out of RSS
 }
+
+namespace {
 
 uint32_t bigEndian32(const uint8_t* p) {
   return uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | uint32_t(p[3]);
@@ -112,7 +114,7 @@ bool PngFastPath::decode(const uint8_t* bytes, std::size_t size, int bit_depth, 
   // 1. Chunks after the 8-byte signature: CRCs checked, IDAT payloads gathered, up to IEND.
   std::size_t compressed_size = 0;
   bool ended = false;
-  ensureSize(&compressed_, size);  // the IDAT payloads are part of the file
+  compressed_.ensure(size);  // the IDAT payloads are part of the file
   for (std::size_t at = 8; !ended;) {
     if (size - at < 12) {
       std::snprintf(error, error_size, "corrupt or truncated PNG (file ends early)");
@@ -141,7 +143,7 @@ bool PngFastPath::decode(const uint8_t* bytes, std::size_t size, int bit_depth, 
   const std::size_t bpp = std::size_t(channels) * std::size_t(bit_depth / 8);
   const std::size_t row_bytes = std::size_t(dst.cols) * bpp;
   const std::size_t expected = std::size_t(dst.rows) * (row_bytes + 1);
-  ensureSize(&filtered_, expected);
+  filtered_.ensure(expected);
   if (zero_row_.size() < row_bytes) zero_row_.assign(row_bytes, 0);
   const libdeflate_result r = libdeflate_zlib_decompress(static_cast<libdeflate_decompressor*>(decompressor_),
                                                          compressed_.data(), compressed_size, filtered_.data(),

@@ -6,6 +6,7 @@
 // with libdeflate (PLUMB_HAVE_LIBDEFLATE) and falls back to libpng for every other layout.
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -27,9 +28,17 @@ class PngFastPath {
               std::size_t error_size);
 
  private:
+  // Scratch that every decode writes before reading, grown with 50 % headroom and NOT zero-filled
+  // (new uint8_t[n]): the headroom costs address space, not resident memory.
+  struct Scratch {
+    std::unique_ptr<uint8_t[]> bytes;
+    std::size_t size = 0;
+    uint8_t* data() { return bytes.get(); }
+    void ensure(std::size_t needed);
+  };
   void* decompressor_ = nullptr;        // struct libdeflate_decompressor*
-  std::vector<uint8_t> compressed_;     // the IDAT payloads, concatenated (one zlib stream)
-  std::vector<uint8_t> filtered_;       // inflated scanlines (filter byte + row), unfiltered in place
+  Scratch compressed_;                  // the IDAT payloads, concatenated (one zlib stream)
+  Scratch filtered_;                    // inflated scanlines (filter byte + row), unfiltered in place
   std::vector<uint8_t> zero_row_;       // the row "above" the first one
 };
 

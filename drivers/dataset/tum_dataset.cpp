@@ -49,7 +49,8 @@ int64_t monotonicNowNs() {
 
 // Reads the whole file into `bytes` (grown only when a file is larger than any before: no
 // allocation per frame; POSIX read, because stdio's FILE allocates its buffer on every fopen).
-Status readFileBytes(const std::string& path, std::vector<unsigned char>* bytes, std::size_t* size) {
+Status readFileBytes(const std::string& path, std::unique_ptr<unsigned char[]>* bytes, std::size_t* capacity,
+                     std::size_t* size) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) return Status::Error(path + ": missing or unreadable image file");
   struct stat st {};
@@ -60,11 +61,14 @@ Status readFileBytes(const std::string& path, std::vector<unsigned char>* bytes,
   const auto expected = static_cast<std::size_t>(st.st_size);
   // 50 % headroom: file sizes vary from frame to frame; growing to exactly the largest so far
   // would reallocate whenever a later frame beats it.
-  if (bytes->size() < expected) bytes->resize(expected + expected / 2);
+  if (*capacity < expected) {
+    *capacity = expected + expected / 2;
+    bytes->reset(new unsigned char[*capacity]);  // contents need not survive: read anew below
+  }
   std::size_t got = 0;
   bool failed = false;
   while (got < expected) {
-    const ssize_t n = ::read(fd, bytes->data() + got, expected - got);
+    const ssize_t n = ::read(fd, bytes->get() + got, expected - got);
     if (n < 0 && errno == EINTR) continue;
     failed = n < 0;
     if (n <= 0) break;  // error, or the file shrank meanwhile (a truncated image: the decoder says so)
@@ -122,9 +126,9 @@ Status TumDatasetSource::open(const std::string& dir, const PinholeCamera& camer
 
 Status TumDatasetSource::loadImage(const std::string& path, bool is_depth, cv::Mat& dst) {
   std::size_t size = 0;
-  PLUMB_RETURN_IF_ERROR(readFileBytes(path, &file_bytes_, &size));
+  PLUMB_RETURN_IF_ERROR(readFileBytes(path, &file_bytes_, &file_capacity_, &size));
   PngHeader header;
-  if (png_->readHeader(file_bytes_.data(), size, &header)) {
+  if (png_->readHeader(file_bytes_.get(), size, &header)) {
     // PNG (every TUM and ICL-NUIM image): libpng straight into dst, checked before decoding.
     const int type = CV_MAKETYPE(header.bit_depth == 16 ? CV_16U : CV_8U, header.channels);
     const std::string problem = imageProblem(type, header.width, header.height, is_depth, camera_);
@@ -132,15 +136,15 @@ Status TumDatasetSource::loadImage(const std::string& path, bool is_depth, cv::M
     if (!png_->decodePixels(dst)) return Status::Error(path + ": " + png_->error());
     return Status::Ok();
   }
-  if (size >= 8 && std::memcmp(file_bytes_.data(), "\x89PNG\r\n\x1a\n", 8) == 0) {
+  if (size >= 8 && std::memcmp(file_bytes_.get(), "\x89PNG\r\n\x1a\n", 8) == 0) {
     return Status::Error(path + ": " + png_->error());  // a PNG libpng rejected
   }
   // A JPEG colour stream (some converted datasets store rgb/*.jpg): libjpeg, which allocates per
   // image. Grey JPEGs stay one channel so that a JPEG depth map is caught below, not converted.
-  if (!looksLikeJpeg(file_bytes_.data(), size))
+  if (!looksLikeJpeg(file_bytes_.get(), size))
     return Status::Error(path + ": corrupt, truncated or not an image (plumb reads PNG and JPEG)");
   std::string error;
-  if (!decodeJpeg(file_bytes_.data(), size, dst, &error)) return Status::Error(path + ": " + error);
+  if (!decodeJpeg(file_bytes_.get(), size, dst, &error)) return Status::Error(path + ": " + error);
   const std::string problem = imageProblem(dst.type(), dst.cols, dst.rows, is_depth, camera_);
   if (!problem.empty()) return Status::Error(path + ": " + problem);
   return Status::Ok();

@@ -69,7 +69,10 @@ class TumDatasetSource : public FrameSource {
   std::size_t cursor_ = 0;
   Status last_error_;
   std::vector<std::string> rgb_files_, depth_files_;  // full paths, per frame
-  std::vector<unsigned char> file_bytes_;  // reused read buffer for image files
+  // Reused read buffer for image files, grown with headroom by new[] (not zero-filled: the
+  // headroom costs address space, not resident memory).
+  std::unique_ptr<unsigned char[]> file_bytes_;
+  std::size_t file_capacity_ = 0;
   std::unique_ptr<PngDecoder> png_;
 };
 

@@ -23,6 +23,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "solver/zero_page_allocator.h"
+
 namespace plumb {
 
 struct LineSegmentDetectorOptions {
@@ -54,11 +56,16 @@ class LineSegmentDetector {
   int width_ = 0, height_ = 0;
   std::vector<float> magnitude_, dir_x_, dir_y_;  // per pixel; unit gradient direction
   std::vector<uint8_t> state_;                    // 1 free, 0 used or below threshold (padded, see .cpp)
-  std::vector<int> bucket_start_, ordered_;       // bucket sort of candidate pixels
-  std::vector<int> candidate_;                    // candidates in raster order ...
-  std::vector<uint16_t> candidate_bin_;           // ... and their magnitude bins
-  std::vector<int> region_;                       // pixel indices of the growing region
-  std::vector<int16_t> region_x_, region_y_;      // ... and their coordinates (no divisions)
+  // Sized for every pixel but filled only up to the candidates / the largest region: zero pages
+  // (the same zeros resize() would write), resident only as far as a frame reaches.
+  template <class T>
+  using Scratch = std::vector<T, ZeroPageAllocator<T>>;
+  std::vector<int> bucket_start_;
+  Scratch<int> ordered_;                          // bucket sort of candidate pixels
+  Scratch<int> candidate_;                        // candidates in raster order ...
+  Scratch<uint16_t> candidate_bin_;               // ... and their magnitude bins
+  Scratch<int> region_;                           // pixel indices of the growing region
+  Scratch<int16_t> region_x_, region_y_;          // ... and their coordinates (no divisions)
 };
 
 }  // namespace plumb

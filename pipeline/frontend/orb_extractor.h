@@ -18,6 +18,7 @@
 #include "pipeline/frontend/image_pyramid.h"
 #include "pipeline/frontend/orb_descriptor.h"
 #include "pipeline/frontend/orb_fast.h"
+#include "solver/zero_page_allocator.h"
 
 namespace plumb {
 
@@ -48,9 +49,12 @@ class OrbExtractor {
   std::array<int, kPyramidLevels> features_per_level_{};
   // Sorting scratch, sized in the constructor, never grows: corners grouped by cell (ranked_),
   // then by rank (by_rank_, which first holds each raw corner's cell), and the counting-sort
-  // bucket starts per cell and per rank.
-  std::vector<RankedCorner> ranked_, by_rank_;
-  std::vector<int> cell_start_, rank_start_;
+  // bucket starts per cell and per rank. Sized for kMaxCornersPerLevel (40,000: 1.4 MB) but
+  // from zero pages (all-zero bytes are the default values of these types, and every entry is
+  // written before it is read): resident only up to the most corners a level has had.
+  std::vector<RankedCorner, ZeroPageAllocator<RankedCorner>> ranked_, by_rank_;
+  std::vector<int> cell_start_;
+  std::vector<int, ZeroPageAllocator<int>> rank_start_;
   std::vector<char> cell_has_corner_;  // per spreading cell of the current level (sized for 8 px cells)
   double pyramid_ms_ = 0;
 };

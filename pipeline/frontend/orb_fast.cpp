@@ -39,9 +39,9 @@ int fastScore(const uint8_t* p, int stride) {
 
 FastDetector::FastDetector(int max_width, int max_height, int capacity)
     : capacity_(capacity), score_(max_height, max_width, CV_8UC1, cv::Scalar(0)),
-      storage_(new FastCorner[2 * static_cast<size_t>(capacity)]) {
-  raw_ = storage_.get();
-  kept_ = storage_.get() + capacity;
+      storage_(2 * static_cast<size_t>(capacity)) {
+  raw_ = storage_.data();
+  kept_ = storage_.data() + capacity;
 }
 
 void FastDetector::begin(const cv::Mat& image, int border) {

@@ -6,8 +6,11 @@
 // intrinsics (SSE2, the x86-64 baseline; NEON on ARM).
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include <opencv2/core.hpp>
+
+#include "solver/zero_page_allocator.h"
 
 namespace plumb {
 
@@ -41,7 +44,9 @@ class FastDetector {
   cv::Mat score_;       // CV_8UC1, max size, scores of raw corners (0 = not a corner)
   FastCorner* raw_;     // before suppression
   FastCorner* kept_;    // after suppression
-  std::unique_ptr<FastCorner[]> storage_;
+  // 2 x capacity corners (raw, kept) from zero pages: all-zero bytes are default FastCorners, and
+  // only as many as a level has had become resident.
+  std::vector<FastCorner, ZeroPageAllocator<FastCorner>> storage_;
   int dropped_ = 0;
   int num_raw_ = 0;
   cv::Mat image_;  // header of the image being scanned (no copy)

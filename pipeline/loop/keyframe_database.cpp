@@ -12,8 +12,9 @@ Status validate(const KeyframeDatabaseOptions& o) {
   if (o.max_keyframes < 1 || o.max_keyframes > 65535)
     return Status::Error("keyframe database: max_keyframes must be in 1..65535");
   if (o.max_point_descriptors < 0 || o.max_line_descriptors < 0 ||
-      o.max_point_descriptors + o.max_line_descriptors < 1)
-    return Status::Error("keyframe database: descriptor limits must be >= 0 and not both 0");
+      o.max_point_descriptors + o.max_line_descriptors < 1 || o.max_point_descriptors > 65535 ||
+      o.max_line_descriptors > 65535)
+    return Status::Error("keyframe database: descriptor limits must be in 0..65535 and not both 0");
   if (o.max_postings < 1) return Status::Error("keyframe database: max_postings must be >= 1");
   if (o.bits_per_word < kMinWordBits || o.bits_per_word > kMaxWordBits)
     return Status::Error("keyframe database: bits_per_word must be in " + std::to_string(kMinWordBits) +
@@ -27,7 +28,6 @@ KeyframeDatabase::KeyframeDatabase(const KeyframeDatabaseOptions& options) : opt
   assert(validate(options).ok());
   num_words_total_ = std::size_t(2) << options.bits_per_word;
   word_head_.assign(num_words_total_, kNone);
-  word_keyframes_.assign(num_words_total_, 0);
   postings_.resize(std::size_t(options.max_postings));
   // Free postings chained in index order, so the first insert uses postings 0, 1, 2, ...
   for (std::size_t i = 0; i < postings_.size(); ++i)
@@ -112,13 +112,10 @@ Status KeyframeDatabase::insertHistogram(uint64_t keyframe_id, const WordCount* 
     Posting& posting = postings_[p];
     free_posting_head_ = posting.next_in_keyframe;
     posting.word = words[i].word;
-    posting.count = words[i].count;
-    posting.slot = slot_index;
-    posting.prev_in_word = kNone;
+    posting.count = uint16_t(words[i].count);  // <= the kind's descriptor limit (<= 65535)
+    posting.slot = uint16_t(slot_index);
     posting.next_in_word = word_head_[posting.word];
-    if (posting.next_in_word != kNone) postings_[posting.next_in_word].prev_in_word = p;
     word_head_[posting.word] = p;
-    ++word_keyframes_[posting.word];
     posting.next_in_keyframe = kNone;
     *link = p;
     link = &posting.next_in_keyframe;
@@ -136,13 +133,11 @@ Status KeyframeDatabase::remove(uint64_t keyframe_id) {
   for (uint32_t p = slot.first_posting; p != kNone;) {
     Posting& posting = postings_[p];
     const uint32_t next = posting.next_in_keyframe;
-    if (posting.prev_in_word != kNone)
-      postings_[posting.prev_in_word].next_in_word = posting.next_in_word;
-    else
-      word_head_[posting.word] = posting.next_in_word;
-    if (posting.next_in_word != kNone) postings_[posting.next_in_word].prev_in_word = posting.prev_in_word;
-    --word_keyframes_[posting.word];
-    posting.prev_in_word = posting.next_in_word = kNone;
+    // Unlink from the word's list: find the link that points at p (the head or a predecessor).
+    uint32_t* link = &word_head_[posting.word];
+    while (*link != p) link = &postings_[*link].next_in_word;
+    *link = posting.next_in_word;
+    posting.next_in_word = kNone;
     posting.next_in_keyframe = free_posting_head_;
     free_posting_head_ = p;
     p = next;
@@ -185,7 +180,7 @@ std::size_t KeyframeDatabase::memoryBytesFor(const KeyframeDatabaseOptions& o) {
   const std::size_t words = std::size_t(2) << o.bits_per_word;
   const std::size_t keyframes = std::size_t(o.max_keyframes);
   const std::size_t descriptors = std::size_t(o.max_point_descriptors + o.max_line_descriptors);
-  return sizeof(KeyframeDatabase) + words * 2 * sizeof(uint32_t) +
+  return sizeof(KeyframeDatabase) + words * sizeof(uint32_t) +
          std::size_t(o.max_postings) * sizeof(Posting) +
          keyframes * (sizeof(KeyframeSlot) + sizeof(uint32_t) /*free_slots_*/ + 2 * sizeof(double) +
                       sizeof(uint32_t) + sizeof(uint8_t) + sizeof(Scored)) +
@@ -194,7 +189,7 @@ std::size_t KeyframeDatabase::memoryBytesFor(const KeyframeDatabaseOptions& o) {
 
 std::size_t KeyframeDatabase::memoryBytes() const {
   return sizeof(*this) + word_head_.capacity() * sizeof(uint32_t) +
-         word_keyframes_.capacity() * sizeof(uint32_t) + postings_.capacity() * sizeof(Posting) +
+         postings_.capacity() * sizeof(Posting) +
          slots_.capacity() * sizeof(KeyframeSlot) + free_slots_.capacity() * sizeof(uint32_t) +
          word_values_scratch_.capacity() * sizeof(uint32_t) + words_scratch_.capacity() * sizeof(WordCount) +
          (accumulator_[0].capacity() + accumulator_[1].capacity()) * sizeof(double) +

@@ -45,7 +45,7 @@ struct KeyframeDatabaseOptions {
   // keyframe graph is kept bounded by culling.
   int max_keyframes = 512;
   // Descriptors one keyframe may bring (defaults: the front end's capacities kMaxKeypoints and
-  // kMaxLines); a keyframe with more is refused.
+  // kMaxLines; at most 65535 each); a keyframe with more is refused.
   int max_point_descriptors = 1200;
   int max_line_descriptors = 200;
   // Postings (distinct words of a keyframe = one posting each) over all keyframes. A 1000-point,
@@ -126,16 +126,18 @@ class KeyframeDatabase {
  private:
   static constexpr uint32_t kNone = UINT32_MAX;
 
-  // One posting: keyframe `slot` contains `word` `count` times. Linked in its word's list (both
-  // ways, so removal is O(1) per posting) and in its keyframe's list.
+  // One posting: keyframe `slot` contains `word` `count` times. Linked in its word's list and in
+  // its keyframe's list, forward only: 16 bytes. Removing a keyframe finds each posting's
+  // predecessor by walking its word's list from the head (at most one posting per keyframe held),
+  // which costs a cull a few hundred thousand steps, about one query's worth.
   struct Posting {
     uint32_t word = 0;
-    uint32_t count = 0;
-    uint32_t slot = 0;
-    uint32_t prev_in_word = kNone;
+    uint16_t count = 0;  // <= max descriptors of a kind (validate(): <= 65535)
+    uint16_t slot = 0;   // < max_keyframes (<= 65535)
     uint32_t next_in_word = kNone;
     uint32_t next_in_keyframe = kNone;
   };
+  static_assert(sizeof(uint16_t) == 2, "Posting packs to 16 bytes");
   struct KeyframeSlot {
     uint64_t id = 0;
     bool used = false;
@@ -160,7 +162,6 @@ class KeyframeDatabase {
   std::size_t num_words_total_ = 0;  // 2 * 2^K
 
   std::vector<uint32_t> word_head_;       // per word: first posting, kNone if empty
-  std::vector<uint32_t> word_keyframes_;  // per word: n_w, keyframes containing it
   std::vector<Posting> postings_;
   uint32_t free_posting_head_ = kNone;  // free postings chained through next_in_keyframe
   std::size_t free_postings_ = 0;

@@ -28,8 +28,11 @@ std::size_t KeyframeDatabase::histogram(const PlaceDescriptors& descriptors) {
 }
 
 double KeyframeDatabase::idf(uint32_t word) const {
-  const double n_w = std::max<uint32_t>(word_keyframes_[word], 1u);
-  return std::log(1.0 + double(num_keyframes_) / n_w);
+  // n_w = the length of the word's list (a keyframe has at most one posting per word): counted
+  // here rather than kept per word, which would cost 2^(K+1) counters (256 KB at K = 16).
+  uint32_t n_w = 0;
+  for (uint32_t p = word_head_[word]; p != kNone; p = postings_[p].next_in_word) ++n_w;
+  return std::log(1.0 + double(num_keyframes_) / double(std::max<uint32_t>(n_w, 1u)));
 }
 
 void KeyframeDatabase::query(const PlaceDescriptors& descriptors, const PlaceQueryOptions& options,

@@ -74,8 +74,9 @@ std::size_t LoopCloser::memoryBytesFor(const LoopCloserOptions& o) {
   // reserveChainWithExtraEdges(): H and the factor's value + index arrays (12 bytes an entry).
   const std::size_t edges = slots + 1 + std::size_t(o.max_loop_edges);
   const std::size_t sparse =
-      12 * (21 * slots + 36 * edges + slots * (15 + 36 * (1 + std::size_t(o.max_loop_edges))));
-  return sizeof(LoopCloser) + slots * (sizeof(LoopKeyframe) + sizeof(Node) + 2 * sizeof(int)) +
+      12 * (21 * slots + 36 * edges +
+            std::size_t(PoseGraph::chainFactorEntries(int(slots), o.max_loop_edges)));
+  return sizeof(LoopCloser) + slots * (sizeof(LoopCandidate) + sizeof(Node) + 2 * sizeof(int)) +
          std::size_t(o.max_loop_edges) * sizeof(LoopEdge) +
          KeyframeDatabase::memoryBytesFor(databaseOptions(o)) + graph + sparse + sizeof(LoopVerifier) +
          110 * 1024;  // verifier scratch (~105 KB)
@@ -120,11 +121,11 @@ void LoopCloser::addNode(const LoopKeyframe& r, int slot) {
   Node& n = nodes_[std::size_t(slot)];
   n = Node{};
   n.id = r.id;
+  n.T_world_record = r.T_world_cam;
   if (order_.empty()) {
     n.T_world_cam = r.T_world_cam;  // the graph's frame is the first keyframe's mapping frame
   } else {
     const Node& previous = nodes_[std::size_t(order_.back())];
-    const LoopKeyframe& previous_record = records_[std::size_t(order_.back())];
     n.has_edge = true;
     if (!r.new_segment && r.previous_id == previous.id) {
       n.previous_map_id = r.previous_id;
@@ -133,7 +134,7 @@ void LoopCloser::addNode(const LoopKeyframe& r, int slot) {
     } else {
       // A new segment, or the previous keyframe's record never arrived (full ring): the relative
       // pose of the two records as the mapping side had them, with the weak segment covariance.
-      n.T_previous_this = previous_record.T_world_cam.inverse() * r.T_world_cam;
+      n.T_previous_this = previous.T_world_record.inverse() * r.T_world_cam;
       n.edge_covariance =
           diagonalCovariance(options_.segment_translation_sigma_m, options_.segment_rotation_sigma_rad);
     }
@@ -149,8 +150,8 @@ bool LoopCloser::addKeyframe(const LoopKeyframe& record) {
   if (free_slots_.empty()) return false;  // cannot happen: culling keeps one slot free
   const int slot = free_slots_.back();
   free_slots_.pop_back();
-  records_[std::size_t(slot)] = record;
-  const LoopKeyframe& r = records_[std::size_t(slot)];
+  makeLoopCandidate(record, &records_[std::size_t(slot)]);
+  const LoopKeyframe& r = record;
   addNode(r, slot);
   const int query_position = int(order_.size()) - 1;
 
@@ -166,7 +167,7 @@ bool LoopCloser::addKeyframe(const LoopKeyframe& record) {
     q.min_score = options_.min_candidate_score;
     database_.query(descriptors, q, &candidates_);
     const std::size_t before = stats_.loops_accepted;
-    detect(query_position);
+    detect(r, query_position);
     accepted = stats_.loops_accepted > before;
   } else {
     groups_.clear();
@@ -180,9 +181,8 @@ bool LoopCloser::addKeyframe(const LoopKeyframe& record) {
   return accepted;
 }
 
-void LoopCloser::detect(int query_position) {
+void LoopCloser::detect(const LoopKeyframe& query_record, int query_position) {
   const Node& query = nodes_[std::size_t(order_[std::size_t(query_position)])];
-  const LoopKeyframe& query_record = records_[std::size_t(order_[std::size_t(query_position)])];
   // Consistency: each candidate inherits the count of the previous query's nearest group.
   new_groups_.clear();
   for (const PlaceCandidate& c : candidates_) {
@@ -206,7 +206,7 @@ void LoopCloser::detect(int query_position) {
     if (candidate_position < 0) continue;  // culled meanwhile
     ++verified;
     ++stats_.verifications;
-    const LoopKeyframe& candidate = records_[std::size_t(order_[std::size_t(candidate_position)])];
+    const LoopCandidate& candidate = records_[std::size_t(order_[std::size_t(candidate_position)])];
     LoopMeasurement m = verifier_.verify(query_record, candidate);
     if (m.accepted() && !plausible(candidate_position, query_position, m))
       m.rejection = LoopRejection::kImplausible;

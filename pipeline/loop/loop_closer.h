@@ -21,16 +21,16 @@
 // to its two graph neighbours; not the first, the newest, or one with a loop edge) is culled: its two
 // odometry edges are composed into one (covariances propagated), it leaves the database.
 //
-// MEMORY: everything is allocated in the constructor (memoryBytes(): 25.0 MB at the default
-// capacity 256, 7.5 MB of it the pose graph's reserved sparse arrays; docs/LOOP.md). addKeyframe() makes
-// no operator-new allocation; when a loop is accepted, PoseGraph::analyze() (the graph is rebuilt:
-// culling changes its structure) still makes a few malloc calls (Eigen's outer-index arrays).
+// MEMORY: everything is allocated in the constructor AND written there, so it is resident from the
+// start and a run's resident set does not grow as the graph fills (memoryBytes(); docs/LOOP.md
+// "Memory"). addKeyframe() makes no operator-new allocation; when a loop is accepted,
+// PoseGraph::analyze() (the graph is rebuilt: culling changes its structure) still makes a few
+// malloc calls (Eigen's outer-index arrays).
 #include <chrono>
 #include <cstdint>
 #include <memory>
 #include <vector>
 
-#include "solver/zero_page_allocator.h"
 #include "pipeline/loop/keyframe_database.h"
 #include "pipeline/loop/loop_keyframe.h"
 #include "pipeline/loop/loop_verifier.h"
@@ -40,8 +40,8 @@
 namespace plumb::loop {
 
 struct LoopCloserOptions {
-  int capacity = 256;          // keyframe records = database entries = graph nodes
-  int max_loop_edges = 64;     // the oldest loop edge is forgotten when full
+  int capacity = 128;          // keyframe records = database entries = graph nodes (docs/LOOP.md "Memory")
+  int max_loop_edges = 24;     // the oldest loop edge is forgotten when full
   int min_age_keyframes = 40;  // candidate id <= query id - this (the local map holds 32)
   int candidates = 10;         // database results per query
   double min_candidate_score = 0.02;
@@ -124,7 +124,8 @@ class LoopCloser {
  private:
   struct Node {
     uint32_t id = 0;
-    Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();  // graph estimate
+    Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();     // graph estimate
+    Eigen::Isometry3d T_world_record = Eigen::Isometry3d::Identity();  // the record's, at creation
     bool has_edge = false;                                          // from the previous node in order_
     Eigen::Isometry3d T_previous_this = Eigen::Isometry3d::Identity();
     Matrix6d edge_covariance = Matrix6d::Identity();  // of this node, previous held fixed
@@ -148,7 +149,7 @@ class LoopCloser {
   int findPosition(uint32_t id) const;  // index into order_, -1 if absent
   void addNode(const LoopKeyframe& record, int slot);
   void cullOne();
-  void detect(int query_position);
+  void detect(const LoopKeyframe& query_record, int query_position);
   bool plausible(int candidate_position, int query_position, const LoopMeasurement& m) const;
   void optimise();
   Matrix6d edgeCovariance(bool new_segment, const Matrix6d& covariance, bool covariance_valid) const;
@@ -157,10 +158,9 @@ class LoopCloser {
   LoopVerifier verifier_;
   KeyframeDatabase database_;
   PoseGraph graph_;
-  // By slot. Reserved for the full capacity at start, but from zero pages (calloc): a slot costs
-  // resident memory only once a keyframe is stored in it (assigned whole before it is ever read),
-  // so a short run does not carry the capacity of an hour-long one.
-  std::vector<LoopKeyframe, ZeroPageAllocator<LoopKeyframe>> records_;
+  // By slot: what verification needs of each keyframe as a candidate. Value-initialised for the
+  // full capacity at start (resident from then on: memory is the same at frame 1,000 and 10,000).
+  std::vector<LoopCandidate> records_;
   std::vector<Node> nodes_;                  // by slot
   std::vector<int> free_slots_;
   std::vector<int> order_;  // slots by ascending keyframe id

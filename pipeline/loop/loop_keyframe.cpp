@@ -43,6 +43,24 @@ void fillLoopFeatures(const FrameFeatures& f, LoopKeyframe* out) {
   }
 }
 
+void makeLoopCandidate(const LoopKeyframe& r, LoopCandidate* out) {
+  out->id = r.id;
+  out->num_points = uint16_t(r.points.size());
+  for (std::size_t k = 0; k < r.points.size(); ++k) {
+    out->point_descriptors[k] = r.point_descriptors[k];
+    out->P_cam[k] = r.points[k].P_cam;
+  }
+  out->num_lines = uint16_t(r.lines.size());
+  uint16_t next = 0;
+  for (std::size_t k = 0; k < r.lines.size(); ++k) {
+    const LoopLine& line = r.lines[k];
+    out->line_descriptors[k] = r.line_descriptors[k];
+    out->num_samples[k] = line.num_samples;
+    out->first_sample[k] = next;
+    for (std::size_t s = 0; s < line.num_samples; ++s) out->samples_cam[next++] = line.samples_cam[s];
+  }
+}
+
 bool makeLoopKeyframe(const KeyframeRequest& request, uint32_t keyframe_id, bool new_segment,
                       const LocalMapper& mapper, LoopKeyframe* out) {
   const Map& map = mapper.map();

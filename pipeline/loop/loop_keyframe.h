@@ -12,7 +12,8 @@
 //   odometry: the pose of this keyframe relative to the previous keyframe of the map, taken from the
 //           mapper's poses right after this keyframe's local BA, and this keyframe's marginal
 //           covariance from that BA (the pose graph's odometry edge and its weight).
-// Size: sizeof(LoopKeyframe), ~43 KB (computed in tests/loop/loop_keyframe_test.cpp).
+// Size: sizeof(LoopKeyframe), ~47 KB (computed in tests/loop/loop_keyframe_test.cpp). The closer
+// keeps only a LoopCandidate of each record (below): what verification reads of a CANDIDATE.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <array>
@@ -71,6 +72,28 @@ struct LoopKeyframe {
     line_descriptors.clear();
   }
 };
+
+// What the LoopCloser stores of a record once the record has been queried: a keyframe is verified
+// as the QUERY only when it arrives (the full LoopKeyframe is at hand then) and later only as a
+// CANDIDATE, for which LoopVerifier::verify reads the point descriptors and 3D points and the line
+// descriptors and line-guidance samples, nothing else. The samples of all lines share one array
+// (line k's are [first_sample[k], first_sample[k] + num_samples[k])). Values are copied, not
+// converted: verification against a LoopCandidate is bit-identical to the full record.
+// 37.5 KB against 47.4 KB for the full record (docs/LOOP.md "Memory").
+struct LoopCandidate {
+  uint32_t id = 0;
+  uint16_t num_points = 0;
+  uint16_t num_lines = 0;
+  std::array<Descriptor256, kMaxLoopPoints> point_descriptors{};
+  std::array<Eigen::Vector3f, kMaxLoopPoints> P_cam{};  // camera frame
+  std::array<Descriptor256, kMaxLoopLines> line_descriptors{};
+  std::array<uint8_t, kMaxLoopLines> num_samples{};
+  std::array<uint16_t, kMaxLoopLines> first_sample{};
+  std::array<Eigen::Vector3f, kMaxLoopLines * kMaxLineSamples> samples_cam{};  // camera frame
+};
+
+// The candidate part of a record. Allocation-free.
+void makeLoopCandidate(const LoopKeyframe& record, LoopCandidate* out);
 
 // The features of a record from a frame's features: the strongest keypoints with depth (response
 // descending, index ascending on ties: deterministic) and the first lines with a 3D fit (the front

@@ -64,18 +64,18 @@ int bestMatch(const Descriptor256& d, const Descriptor256* others, std::size_t n
 
 }  // namespace
 
-LoopMeasurement LoopVerifier::verify(const LoopKeyframe& query, const LoopKeyframe& candidate) {
+LoopMeasurement LoopVerifier::verify(const LoopKeyframe& query, const LoopCandidate& candidate) {
   LoopMeasurement m;
   Scratch& s = *s_;
   // 1. Points.
   int n = 0;
   for (std::size_t k = 0; k < query.points.size(); ++k) {
     const int j = bestMatch(query.point_descriptors[k], candidate.point_descriptors.data(),
-                            candidate.point_descriptors.size(), options_.hamming_threshold, options_.ratio);
+                            candidate.num_points, options_.hamming_threshold, options_.ratio);
     if (j < 0) continue;
     s.query_index[std::size_t(n)] = uint16_t(k);
     s.from[std::size_t(n)] = query.points[k].P_cam.cast<double>();
-    s.to[std::size_t(n)] = candidate.points[std::size_t(j)].P_cam.cast<double>();
+    s.to[std::size_t(n)] = candidate.P_cam[std::size_t(j)].cast<double>();
     ++n;
   }
   m.matches = n;
@@ -114,15 +114,15 @@ LoopMeasurement LoopVerifier::verify(const LoopKeyframe& query, const LoopKeyfra
   if (options_.use_lines) {
     for (std::size_t k = 0; k < query.lines.size(); ++k) {
       const int j =
-          bestMatch(query.line_descriptors[k], candidate.line_descriptors.data(),
-                    candidate.line_descriptors.size(), options_.line_hamming_threshold, options_.line_ratio);
+          bestMatch(query.line_descriptors[k], candidate.line_descriptors.data(), candidate.num_lines,
+                    options_.line_hamming_threshold, options_.line_ratio);
       if (j < 0) continue;
       ++m.line_matches;
-      const LoopLine& c = candidate.lines[std::size_t(j)];
+      const std::size_t first = candidate.first_sample[std::size_t(j)];
       const LoopLine& q = query.lines[k];
-      for (int smp = 0; smp < c.num_samples; ++smp) {
+      for (std::size_t smp = 0; smp < candidate.num_samples[std::size_t(j)]; ++smp) {
         PoseLineObservation& obs = s.pose_lines[std::size_t(num_lines++)];
-        obs.P_world = c.samples_cam[std::size_t(smp)].cast<double>();
+        obs.P_world = candidate.samples_cam[first + smp].cast<double>();
         obs.line = q.l.cast<double>();
         obs.information = lineSampleInformation(noise_, q.octave);
       }

@@ -71,7 +71,8 @@ class LoopVerifier {
   LoopVerifier(const LoopVerifier&) = delete;
   LoopVerifier& operator=(const LoopVerifier&) = delete;
 
-  LoopMeasurement verify(const LoopKeyframe& query, const LoopKeyframe& candidate);
+  // The candidate as the closer stores it (LoopCandidate: makeLoopCandidate of its record).
+  LoopMeasurement verify(const LoopKeyframe& query, const LoopCandidate& candidate);
   const LoopVerifierOptions& options() const { return options_; }
 
  private:

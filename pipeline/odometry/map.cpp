@@ -1,8 +1,28 @@
 #include "pipeline/odometry/map.h"
 
+#include <type_traits>
+
+#include "solver/zero_page_allocator.h"
+
 namespace plumb {
 
-Map::Map() : s_(std::make_unique<Storage>()) { clear(); }
+static_assert(std::is_trivially_destructible_v<Keyframe> && std::is_trivially_destructible_v<MapPoint> &&
+                  std::is_trivially_destructible_v<MapLine>,
+              "Map::Storage is released without running destructors");
+
+void Map::StorageDeleter::operator()(Storage* s) const { ZeroPageAllocator<Storage>().deallocate(s, 1); }
+
+// Zero bytes are the cleared state (see Storage), so only the free lists are written here: the
+// slot arrays cost resident memory as the map uses them, not at start.
+Map::Map() : s_(ZeroPageAllocator<Storage>().allocate(1)) { fillFreeLists(); }
+
+void Map::fillFreeLists() {
+  s_->free_points.clear();
+  s_->free_lines.clear();
+  // Highest slot pushed first so that pop (from the back) hands out slot 0, 1, 2, ...
+  for (std::size_t i = kMaxMapPoints; i-- > 0;) (void)s_->free_points.push_back(uint32_t(i));
+  for (std::size_t i = kMaxMapLines; i-- > 0;) (void)s_->free_lines.push_back(uint32_t(i));
+}
 
 void Map::clear() {
   for (auto& kf : s_->keyframes) {
@@ -12,11 +32,7 @@ void Map::clear() {
   }
   for (auto& p : s_->points) p = MapPoint{};
   for (auto& l : s_->lines) l = MapLine{};
-  s_->free_points.clear();
-  s_->free_lines.clear();
-  // Highest slot pushed first so that pop (from the back) hands out slot 0, 1, 2, ...
-  for (std::size_t i = kMaxMapPoints; i-- > 0;) (void)s_->free_points.push_back(uint32_t(i));
-  for (std::size_t i = kMaxMapLines; i-- > 0;) (void)s_->free_lines.push_back(uint32_t(i));
+  fillFreeLists();
   // Ids keep growing across clear() (a new map segment): a stale message never matches a new id.
 }
 

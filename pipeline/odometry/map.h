@@ -67,7 +67,12 @@ class Map {
   std::size_t freeLineSlots() const { return s_->free_lines.size(); }
 
  private:
-  // Keyframes are ~130 KB each and the landmark arrays a few MB: one heap block, allocated once.
+  // Keyframes are ~130 KB each and the landmark arrays a few MB: one heap block, allocated once,
+  // from kernel zero pages (solver/zero_page_allocator.h): all-zero bytes are the empty map (every
+  // id 0 = free slot, every list empty), and a page becomes resident only when a slot or an
+  // observation list reaches it. Free slots are never read beyond their id (a removed slot keeps
+  // stale values too), and every slot is assigned whole when it is taken (addPoint, addLine) or
+  // has the fields it is read by set (addKeyframe + the mapper's insertion).
   struct Storage {
     std::array<Keyframe, kMaxMapKeyframes> keyframes;
     std::array<MapPoint, kMaxMapPoints> points;
@@ -80,7 +85,11 @@ class Map {
   uint32_t next_keyframe_id_ = 1;
   uint32_t next_point_id_ = 1;
   uint32_t next_line_id_ = 1;
-  std::unique_ptr<Storage> s_;
+  struct StorageDeleter {
+    void operator()(Storage* s) const;
+  };
+  void fillFreeLists();
+  std::unique_ptr<Storage, StorageDeleter> s_;
 };
 
 }  // namespace plumb

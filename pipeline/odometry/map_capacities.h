@@ -23,8 +23,10 @@ constexpr std::size_t kMaxLocalMapPoints = 4000;
 constexpr std::size_t kMaxLocalMapLines = 600;
 
 // Keyframes remembered for relocalization only (pose + descriptors + 3D points in camera frame),
-// a ring independent of the map window.
-constexpr std::size_t kMaxRelocKeyframes = 200;
+// a ring independent of the map window: the last 100 keyframes (~3 local maps; 22 KB each, 2.2 MB,
+// resident from start). It was 200 (4.4 MB) until the memory budget of issue 14: the long-term
+// memory of places is the loop closer's keyframe graph (docs/LOOP.md).
+constexpr std::size_t kMaxRelocKeyframes = 100;
 constexpr std::size_t kMaxRelocFeatures = 500;
 
 }  // namespace plumb

@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <random>
+#include <type_traits>
 
 #include <Eigen/Geometry>
 
 #include "solver/noise_model.h"
 #include "solver/pose_optimizer.h"
+#include "solver/zero_page_allocator.h"
 
 namespace plumb {
 
@@ -25,11 +27,16 @@ Relocalizer::Relocalizer(const PinholeCamera& camera, const OdometryOptions& opt
     : camera_(camera),
       options_(options),
       stored_(std::make_unique<std::array<StoredKeyframe, kMaxRelocKeyframes>>()),
-      s_(std::make_unique<Scratch>()) {
+      s_(ZeroPageAllocator<Scratch>().allocate(1)) {
   intrinsics_ = CameraIntrinsics{camera.fx, camera.fy, camera.cx, camera.cy, camera.fx * camera.baseline_m};
 }
 
 Relocalizer::~Relocalizer() = default;
+
+void Relocalizer::ScratchDeleter::operator()(Scratch* s) const {
+  static_assert(std::is_trivially_destructible_v<Scratch>, "released without a destructor call");
+  ZeroPageAllocator<Scratch>().deallocate(s, 1);
+}
 
 void Relocalizer::addKeyframe(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam,
                               const FrameFeatures& frame) {

@@ -70,8 +70,14 @@ class Relocalizer {
   std::unique_ptr<std::array<StoredKeyframe, kMaxRelocKeyframes>> stored_;
   std::size_t count_ = 0;
   std::size_t next_ = 0;  // ring position of the next insertion
+  // Matching / RANSAC / pose scratch (~250 KB), from zero pages: written before it is read (the
+  // all-zero bytes are empty lists and false flags), so only what a relocalization (or the
+  // keyframe ranking of addKeyframe) reaches becomes resident.
   struct Scratch;
-  std::unique_ptr<Scratch> s_;
+  struct ScratchDeleter {
+    void operator()(Scratch* s) const;
+  };
+  std::unique_ptr<Scratch, ScratchDeleter> s_;
 };
 
 }  // namespace plumb

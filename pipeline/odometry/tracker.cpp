@@ -35,6 +35,7 @@ Tracker::Tracker(const PinholeCamera& camera, const OdometryOptions& options)
       matcher_(options.matcher),
       wide_matcher_(withRadius(options.matcher, options.tracker.wide_search_radius_px)),
       local_matcher_(withRadius(options.matcher, options.tracker.local_map_search_radius_px)),
+      compensated_frame_(1),
       b_(std::make_unique<Buffers>()) {
   intrinsics_ = CameraIntrinsics{camera.fx, camera.fy, camera.cx, camera.cy, camera.fx * camera.baseline_m};
   pose_options_.chi2 = options.tracker.chi2;
@@ -83,10 +84,10 @@ TrackResult Tracker::track(const FrameFeatures& input, uint64_t sequence, double
                            KeyframeRequest* request) {
   const FrameFeatures* features = &input;
   if (camera_.rolling_shutter_readout_s > 0 && has_velocity_ && velocity_dt_s_ > 0) {
-    b_->compensated_frame = input;
+    compensated_frame_[0] = input;
     compensateRollingShutter(camera_, camera_.rolling_shutter_readout_s,
-                             logSE3(velocity_cur_last_) / velocity_dt_s_, &b_->compensated_frame);
-    features = &b_->compensated_frame;
+                             logSE3(velocity_cur_last_) / velocity_dt_s_, &compensated_frame_[0]);
+    features = &compensated_frame_[0];
   }
   const FrameFeatures& frame = *features;
   TrackResult result;

@@ -20,6 +20,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -32,6 +33,7 @@
 #include "pipeline/odometry/tracking_state.h"
 #include "solver/camera_intrinsics.h"
 #include "solver/pose_optimizer.h"
+#include "solver/zero_page_allocator.h"
 
 namespace plumb {
 
@@ -125,9 +127,11 @@ class Tracker {
   uint64_t frame_stamp_ = 0;  // increments per track(): marks landmark slots matched this frame
 
   // Everything big lives in one block allocated at construction.
+  // The input moved to its middle row's time (rolling-shutter cameras only): assigned whole before
+  // it is read, so it lives in zero pages and costs no resident memory on a global-shutter camera.
+  std::vector<FrameFeatures, ZeroPageAllocator<FrameFeatures>> compensated_frame_;
   struct Buffers {
     LocalMap local_map;
-    FrameFeatures compensated_frame;  // the input moved to its middle row's time (rolling shutter)
     FrameFeatures last_frame;
     std::array<PointAssociation, kMaxKeypoints> last_points;  // per last-frame keypoint
     std::array<LineAssociation, kMaxLines> last_lines;

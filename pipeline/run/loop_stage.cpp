@@ -28,7 +28,7 @@ LoopStage::LoopStage(OdometrySystem& system, const loop::LoopCloserOptions& opti
       threaded_(threaded),
       thread_nice_(thread_nice),
       made_(std::make_unique<loop::LoopKeyframe>()),
-      popped_(std::make_unique<loop::LoopKeyframe>()),
+      popped_(threaded ? std::make_unique<loop::LoopKeyframe>() : nullptr),  // only the thread pops
       ring_(kRingCapacity),
       final_ring_(kFinalRingCapacity),
       synchronous_(!threaded) {}
@@ -94,7 +94,7 @@ bool LoopStage::popAndProcess() {
     processFinal(f);
     return true;
   }
-  if (ring_.try_pop(*popped_)) {
+  if (popped_ && ring_.try_pop(*popped_)) {
     process(*popped_);
     return true;
   }

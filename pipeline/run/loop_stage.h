@@ -12,8 +12,8 @@
 //       LatestSnapshot) -> the mapping side applies it before its next frame (mapFrame).
 // finish() (end of run): the thread processes what is left in the ring and stops; then the graph's
 // poses are final (optimisedPoses()).
-// Memory: the LoopCloser (LoopCloser::memoryBytes), two records of scratch and the ring, all
-// allocated in the constructor.
+// Memory: the LoopCloser (LoopCloser::memoryBytes), one record of scratch (two when threaded) and
+// the rings, all allocated in the constructor (the rings' cells are written only when threaded).
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -78,7 +78,7 @@ class LoopStage {
   const bool threaded_;
   const int thread_nice_;
   std::unique_ptr<loop::LoopKeyframe> made_;    // map stage thread
-  std::unique_ptr<loop::LoopKeyframe> popped_;  // loop thread
+  std::unique_ptr<loop::LoopKeyframe> popped_;  // loop thread (threaded modes only)
   runtime::SpscRing<loop::LoopKeyframe> ring_;
   runtime::SpscRing<FinalPose> final_ring_;
   bool synchronous_;  // deterministic mode, or after finish()

@@ -42,6 +42,9 @@ Status runOdometry(FrameCapture& capture, OdometrySystem& system, OdometrySink& 
                          schedule.clock->isVirtual();
   // Lock-step: each frame leaves the pipeline before the next is read, one slot is all it uses.
   if (lock_step) schedule.slot_count = 1;
+  // The trace is read only for `--profile` (keep_trace). Without it, reserving it would cost
+  // 40 B x 8192 per stage that a long run fills and makes resident frame after frame.
+  if (!options.keep_trace) schedule.trace_capacity_per_stage = 0;
   // The stages are the parallelism: OpenCV's own worker pool would compete with them for the
   // cores, and each fresh pool worker allocates thread-local state the first time it runs a
   // cv::parallel_for_ body, i.e. at unpredictable frames of a steady run.

@@ -57,4 +57,11 @@ inline std::unique_ptr<loop::LoopKeyframe> recordOf(const Scene& scene, uint32_t
   return r;
 }
 
+// What the closer stores of a record: the candidate side of verification.
+inline std::unique_ptr<loop::LoopCandidate> candidateOf(const loop::LoopKeyframe& record) {
+  auto c = std::make_unique<loop::LoopCandidate>();
+  loop::makeLoopCandidate(record, c.get());
+  return c;
+}
+
 }  // namespace plumb::test

@@ -42,7 +42,35 @@ TEST(LoopKeyframe, RecordKeepsStrongestPointsWithDepthAndLinesWith3d) {
   }
   EXPECT_EQ(stronger_left_out, 0);
   EXPECT_EQ(r.lines.size(), std::min(view.features->lines.size(), loop::kMaxLoopLines));
-  std::printf("sizeof(LoopKeyframe) = %zu bytes\n", sizeof(loop::LoopKeyframe));
+  std::printf("sizeof(LoopKeyframe) = %zu bytes, sizeof(LoopCandidate) = %zu bytes\n",
+              sizeof(loop::LoopKeyframe), sizeof(loop::LoopCandidate));
+}
+
+TEST(LoopCandidate, KeepsExactlyWhatVerificationReadsOfACandidate) {
+  // The closer verifies against this compact copy, so it must hold the record's values bit for bit:
+  // descriptors and 3D points of every point, descriptor and guidance samples of every line.
+  const Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  const Scene scene = makeScene(14, 1500, 60, T);
+  const auto r = recordOf(scene, 7, T, T, 0, T);
+  ASSERT_GT(r->lines.size(), 10u);
+  const auto c = candidateOf(*r);
+  EXPECT_EQ(c->id, 7u);
+  ASSERT_EQ(c->num_points, r->points.size());
+  for (std::size_t k = 0; k < r->points.size(); ++k) {
+    EXPECT_EQ(c->point_descriptors[k].words, r->point_descriptors[k].words);
+    EXPECT_EQ(c->P_cam[k], r->points[k].P_cam);
+  }
+  ASSERT_EQ(c->num_lines, r->lines.size());
+  std::size_t samples = 0;
+  for (std::size_t k = 0; k < r->lines.size(); ++k) {
+    EXPECT_EQ(c->line_descriptors[k].words, r->line_descriptors[k].words);
+    ASSERT_EQ(c->num_samples[k], r->lines[k].num_samples);
+    EXPECT_EQ(c->first_sample[k], samples);  // packed one line after the other
+    for (std::size_t s = 0; s < r->lines[k].num_samples; ++s)
+      EXPECT_EQ(c->samples_cam[c->first_sample[k] + s], r->lines[k].samples_cam[s]);
+    samples += r->lines[k].num_samples;
+  }
+  EXPECT_GT(samples, 2 * r->lines.size());
 }
 
 TEST(LoopVerifier, RecoversTheRelativePoseOfTwoViewsOfOneScene) {
@@ -52,7 +80,7 @@ TEST(LoopVerifier, RecoversTheRelativePoseOfTwoViewsOfOneScene) {
   const auto a = recordOf(scene, 1, Ta, Ta, 0, Eigen::Isometry3d::Identity());
   const auto b = recordOf(scene, 50, Tb, Tb, 0, Eigen::Isometry3d::Identity());
   auto verifier = makeVerifier();
-  const loop::LoopMeasurement m = verifier.verify(*b, *a);
+  const loop::LoopMeasurement m = verifier.verify(*b, *candidateOf(*a));
   ASSERT_TRUE(m.accepted()) << loop::toString(m.rejection) << " matches " << m.matches;
   const Eigen::Isometry3d truth = Ta.inverse() * Tb;  // query b in candidate a
   EXPECT_LT(translationError(m.T_candidate_query, truth), 1e-4);
@@ -70,7 +98,7 @@ TEST(LoopVerifier, RejectsUnrelatedViews) {
   const View other = unrelatedView(99, 1000);
   loop::fillLoopFeatures(*other.features, b.get());
   auto verifier = makeVerifier();
-  const loop::LoopMeasurement m = verifier.verify(*b, *a);
+  const loop::LoopMeasurement m = verifier.verify(*b, *candidateOf(*a));
   EXPECT_FALSE(m.accepted());
   EXPECT_EQ(m.rejection, loop::LoopRejection::kFewMatches);
   EXPECT_LT(m.matches, 10);
@@ -88,7 +116,7 @@ TEST(LoopVerifier, RejectsMatchesWithoutACommonRigidMotion) {
   const auto a = recordOf(scene, 1, T, T, 0, T);
   const auto b = recordOf(shuffled, 50, T, T, 0, T);
   auto verifier = makeVerifier();
-  const loop::LoopMeasurement m = verifier.verify(*b, *a);
+  const loop::LoopMeasurement m = verifier.verify(*b, *candidateOf(*a));
   EXPECT_GT(m.matches, 200);
   EXPECT_FALSE(m.accepted());
   // RANSAC's depth-scaled threshold lets a few far points agree by chance; the refinement in
