@@ -73,6 +73,24 @@ class RoomBuilder {
   SplitMix64 texture_rng_;
 };
 
+// A picture's random position along its wall and its size. The draws are separate statements: the
+// order in which C++ evaluates function arguments is unspecified (GCC goes right to left on x86-64,
+// left to right on aarch64), and a scene must be the same on every machine. Height, width, position
+// is the order x86-64 builds always used, so existing scenes keep their bytes.
+struct PictureDraws {
+  double position, width, height;
+};
+struct Range {
+  double lo, hi;
+};
+PictureDraws pictureDraws(SplitMix64& rng, Range position, Range width, Range height) {
+  PictureDraws d;
+  d.height = rng.uniform(height.lo, height.hi);
+  d.width = rng.uniform(width.lo, width.hi);
+  d.position = rng.uniform(position.lo, position.hi);
+  return d;
+}
+
 void addShellAndTrim(RoomBuilder& b) {
   const double W = kRoomWidth, D = kRoomDepth, H = kRoomHeight;
   // Walls, floor, ceiling: distinct shades (the low-texture case relies on face contrast).
@@ -159,9 +177,11 @@ void addSouthWall(RoomBuilder& b) {
   b.box({mx - 0.04, 0.12, top}, {mx + 0.04, 0.16, top + 0.15}, b.colour({40, 40, 40}, 10), TextureStyle::kObject);
   b.box({mx - 0.3, 0.1, top + 0.12}, {mx + 0.3, 0.14, top + 0.48}, b.colour({30, 30, 30}, 10), TextureStyle::kObject);
   b.box({mx - 0.27, 0.14, top + 0.15}, {mx + 0.27, 0.145, top + 0.45}, b.colour({120, 90, 60}, 40), TextureStyle::kWall);
-  // Pictures beside it.
-  b.picture({b.rng().uniform(0.8, 1.6), 0, 1.55}, Vector3d::UnitY(), b.rng().uniform(0.5, 0.8), b.rng().uniform(0.4, 0.6));
-  b.picture({b.rng().uniform(5.0, 6.2), 0, 1.5}, Vector3d::UnitY(), b.rng().uniform(0.5, 0.9), b.rng().uniform(0.4, 0.7));
+  // Pictures beside it. Draws in the order height, width, position (see pictureDraws).
+  const PictureDraws left = pictureDraws(b.rng(), {0.8, 1.6}, {0.5, 0.8}, {0.4, 0.6});
+  b.picture({left.position, 0, 1.55}, Vector3d::UnitY(), left.width, left.height);
+  const PictureDraws right = pictureDraws(b.rng(), {5.0, 6.2}, {0.5, 0.9}, {0.4, 0.7});
+  b.picture({right.position, 0, 1.5}, Vector3d::UnitY(), right.width, right.height);
 }
 
 void addWestWall(RoomBuilder& b) {
@@ -174,7 +194,8 @@ void addWestWall(RoomBuilder& b) {
   b.box({depth, ym + 0.005, 0.05}, {depth + 0.015, y1 - 0.02, height - 0.05}, door * 0.93f, TextureStyle::kObject);
   for (double y : {ym - 0.06, ym + 0.04})
     b.box({depth + 0.015, y, 0.9}, {depth + 0.04, y + 0.02, 1.2}, b.colour({50, 50, 50}), TextureStyle::kObject);
-  b.picture({0, b.rng().uniform(3.8, 4.6), 1.5}, Vector3d::UnitX(), b.rng().uniform(0.6, 1.0), b.rng().uniform(0.5, 0.8));
+  const PictureDraws picture = pictureDraws(b.rng(), {3.8, 4.6}, {0.6, 1.0}, {0.5, 0.8});
+  b.picture({0, picture.position, 1.5}, Vector3d::UnitX(), picture.width, picture.height);
 }
 
 void addCentre(RoomBuilder& b) {

@@ -11,8 +11,16 @@
 namespace plumb::synth {
 namespace {
 
+// Every draw below is its own statement: C++ leaves the evaluation order of function (and
+// constructor) arguments unspecified, GCC evaluates them right to left on x86-64 and left to right
+// on aarch64, so `cv::Point(rng.uniformInt(..), rng.uniformInt(..))` gave different textures on the
+// two (docs/EMBEDDED.md). The statements keep the order x86-64 builds always used (last argument
+// first), so existing scenes keep their bytes.
 cv::Scalar randomColour(SplitMix64& rng, double lo = 20, double hi = 235) {
-  return cv::Scalar(rng.uniform(lo, hi), rng.uniform(lo, hi), rng.uniform(lo, hi));
+  const double red = rng.uniform(lo, hi);
+  const double green = rng.uniform(lo, hi);
+  const double blue = rng.uniform(lo, hi);
+  return cv::Scalar(blue, green, red);
 }
 
 // Smooth brightness variations of about +-15% (stains, uneven paint), multiplied in at painting.
@@ -29,9 +37,12 @@ void drawBlobs(TextureCanvas& canvas, double tpm, double per_m2, double min_m, d
   const double area_m2 = canvas.cols * canvas.rows / (tpm * tpm);
   const int count = static_cast<int>(area_m2 * per_m2);
   for (int i = 0; i < count; ++i) {
-    const cv::Point centre(rng.uniformInt(0, canvas.cols - 1), rng.uniformInt(0, canvas.rows - 1));
-    const cv::Size axes(std::max(2, static_cast<int>(rng.uniform(min_m, max_m) * tpm)),
-                        std::max(2, static_cast<int>(rng.uniform(min_m, max_m) * tpm)));
+    const int centre_y = rng.uniformInt(0, canvas.rows - 1);
+    const int centre_x = rng.uniformInt(0, canvas.cols - 1);
+    const cv::Point centre(centre_x, centre_y);
+    const int axis_v = std::max(2, static_cast<int>(rng.uniform(min_m, max_m) * tpm));
+    const int axis_u = std::max(2, static_cast<int>(rng.uniform(min_m, max_m) * tpm));
+    const cv::Size axes(axis_u, axis_v);
     const double angle = rng.uniform(0, 180);
     if (rng.uniform() < 0.7) {
       canvas.ellipse(centre, axes, angle, randomColour(rng), cv::FILLED, cv::LINE_AA);
@@ -64,7 +75,9 @@ void drawCheckerPatch(TextureCanvas& canvas, double tpm, SplitMix64& rng) {
 void drawPoster(TextureCanvas& canvas, double tpm, SplitMix64& rng) {
   const int w = static_cast<int>(rng.uniform(0.3, 0.9) * tpm), h = static_cast<int>(rng.uniform(0.3, 0.8) * tpm);
   if (w >= canvas.cols || h >= canvas.rows) return;
-  const cv::Rect rect(rng.uniformInt(0, canvas.cols - w - 1), rng.uniformInt(0, canvas.rows - h - 1), w, h);
+  const int top = rng.uniformInt(0, canvas.rows - h - 1);
+  const int left = rng.uniformInt(0, canvas.cols - w - 1);
+  const cv::Rect rect(left, top, w, h);
   canvas.rectangle(rect, randomColour(rng, 60, 240), cv::FILLED);
   TextureCanvas inner = canvas.region(rect);
   const int kind = rng.uniformInt(0, 2);
@@ -75,12 +88,15 @@ void drawPoster(TextureCanvas& canvas, double tpm, SplitMix64& rng) {
       const int y = rng.uniformInt(0, h - 1), t = rng.uniformInt(2, std::max(3, h / 10));
       inner.rectangle(cv::Rect(0, y, w, t), colour, cv::FILLED);
     } else if (kind == 1) {
-      inner.circle(cv::Point(rng.uniformInt(0, w - 1), rng.uniformInt(0, h - 1)),
-                   rng.uniformInt(3, std::max(4, w / 6)), colour, cv::FILLED, cv::LINE_AA);
+      const int radius = rng.uniformInt(3, std::max(4, w / 6));
+      const int cy = rng.uniformInt(0, h - 1);
+      const int cx = rng.uniformInt(0, w - 1);
+      inner.circle(cv::Point(cx, cy), radius, colour, cv::FILLED, cv::LINE_AA);
     } else {  // "text": short dark bars in rows
       const int y = rng.uniformInt(0, h - 1), x = rng.uniformInt(0, w - 1);
-      inner.rectangle(cv::Rect(x, y, rng.uniformInt(4, std::max(5, w / 3)), std::max(2, h / 25)),
-                      randomColour(rng, 0, 70), cv::FILLED);
+      const cv::Scalar ink = randomColour(rng, 0, 70);
+      const int length = rng.uniformInt(4, std::max(5, w / 3));
+      inner.rectangle(cv::Rect(x, y, length, std::max(2, h / 25)), ink, cv::FILLED);
     }
   }
   canvas.rectangle(rect, randomColour(rng, 0, 60), std::max(2, static_cast<int>(0.015 * tpm)));
