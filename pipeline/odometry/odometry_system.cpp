@@ -131,8 +131,8 @@ void OdometrySystem::addLoadedKeyframe(uint32_t keyframe_id, const Eigen::Isomet
   ++mapping_.stats.loaded_map_keyframes;
 }
 
-void OdometrySystem::beginInLoadedMap(uint32_t max_loaded_id) {
-  mapping_.mapper->setNextKeyframeId(max_loaded_id + 1);
+void OdometrySystem::beginInLoadedMap(uint32_t first_new_id) {
+  mapping_.mapper->setNextKeyframeId(first_new_id);
   tracking_.map_started = true;
   tracking_.lost = true;
   tracking_.awaiting_loaded_map = true;

@@ -96,10 +96,11 @@ class OdometrySystem {
   // the system in the "relocalize into the loaded map" state: every frame is relocalized against
   // those keyframes (no pose, written `# <t> lost`, until one succeeds; no new map is started
   // meanwhile), and the first that succeeds starts the local map at its relocalized pose, so
-  // tracking continues in the loaded map's frame. New keyframes get ids after `max_loaded_id`.
+  // tracking continues in the loaded map's frame. New keyframes get ids from `first_new_id` on
+  // (> every loaded id).
   void addLoadedKeyframe(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam, std::size_t n,
                          const Descriptor256* descriptors, const Eigen::Vector3f* P_cam);
-  void beginInLoadedMap(uint32_t max_loaded_id);
+  void beginInLoadedMap(uint32_t first_new_id);
 
   // Tracking side. fence may be nullptr (never waits).
   void trackFeatures(const FrameFeatures& features, uint64_t sequence, double timestamp_s, MapperFence* fence,

@@ -97,7 +97,11 @@ Status runOdometry(FrameCapture& capture, OdometrySystem& system, OdometrySink& 
       system.addLoadedKeyframe(k->record.id, k->T_world_cam, points.size(), k->record.point_descriptors.data(),
                                points.data());
     }
-    system.beginInLoadedMap(options.load_map->maxKeyframeId());
+    // New keyframe ids leave a gap of the loop closer's minimum candidate age after the loaded
+    // ones: the closer skips candidates that young (the local window), but a loaded keyframe is
+    // never in this run's window, so the very first new keyframes may already close a loop into
+    // the loaded map (ids only need to grow).
+    system.beginInLoadedMap(options.load_map->maxKeyframeId() + 1 + uint32_t(std::max(0, options.loop.min_age_keyframes)));
     result->map_restore_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - restore_start).count();
   }
