@@ -203,7 +203,7 @@ int runRun(int argc, char** argv) {
   if (args.has("load-map")) {
     const std::string mismatch = loop::cameraMismatch(loaded_map.camera, source->camera());
     if (!mismatch.empty()) {
-      return fail("map " + args.get("load-map") + " was made with another camera: " + mismatch, kExitUsage);
+      return fail("map " + args.get("load-map") + " was made with another camera: " + mismatch);
     }
   }
 
