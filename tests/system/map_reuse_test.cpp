@@ -107,6 +107,36 @@ TEST(MapReuse, SyntheticSecondHalfRelocalizesIntoTheFirstHalfsMap) {
   EXPECT_GT(b_sections[1].bytes.size(), a_sections[1].bytes.size());
 }
 
+// A place the map never saw: every frame is tried against the map, none gets a pose (one `lost`
+// line per input frame), and no map of its own is started in an unrelated frame.
+TEST(MapReuse, AnUnmappedPlaceStaysWithoutPosesAndStartsNoMap) {
+  ScratchDir dir("plumb_map_elsewhere");
+  ASSERT_TRUE(dir.ok());
+  RunResult made = runPlumb("run --dataset synth:textured:1:60 --discard-trajectory --save-map " + dir.file("m.map"));
+  ASSERT_EQ(made.exit_code, 0) << made.output;
+  RunResult elsewhere = runPlumb("run --dataset synth:textured:2:30 --load-map " + dir.file("m.map") + " --out " +
+                                 dir.file("t.txt") + " --stats " + dir.file("s.json"));
+  ASSERT_EQ(elsewhere.exit_code, 0) << elsewhere.output;
+  EXPECT_NE(elsewhere.output.find("never relocalized"), std::string::npos) << elsewhere.output;
+  EXPECT_NE(elsewhere.output.find("map segments 0"), std::string::npos) << elsewhere.output;
+  // (readTumTrajectory refuses a trajectory without a single pose, so the lines are counted here.)
+  std::ifstream trajectory(dir.file("t.txt"));
+  int lost = 0, poses = 0;
+  for (std::string line; std::getline(trajectory, line);) {
+    if (std::regex_match(line, std::regex("# [0-9]+\\.[0-9]{6} lost"))) {
+      ++lost;
+    } else if (!line.empty() && line[0] != '#') {
+      ++poses;
+    }
+  }
+  EXPECT_EQ(lost, 30);
+  EXPECT_EQ(poses, 0);
+  std::ifstream json(dir.file("s.json"));
+  const std::string stats((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
+  EXPECT_NE(stats.find("\"relocalization_attempts\": 30"), std::string::npos);
+  EXPECT_NE(stats.find("\"relocalized_frame\": -1"), std::string::npos);
+}
+
 TEST(MapReuse, BrokenOrForeignMapsAreRefusedBeforeAnyWork) {
   ScratchDir dir("plumb_map_refuse");
   ASSERT_TRUE(dir.ok());
