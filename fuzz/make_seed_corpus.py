@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes the small seed corpora of the fuzz targets into fuzz/corpus/<target>/ (valid examples
-of each format, a few edge cases). The recording seeds come from make_recording_seeds.cpp.
+of each format, a few edge cases). The recording seeds come from make_recording_seeds.cpp, the map file seeds from make_map_seeds.cpp.
 Run from anywhere: python3 fuzz/make_seed_corpus.py"""
 import os
 import random

@@ -10,7 +10,7 @@ set -uo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_PER_TARGET=${1:-60}
 shift || true
-ALL_TARGETS=(png_decoder tum_lists camera_file trajectory_reader json_reader recording_reader)
+ALL_TARGETS=(png_decoder tum_lists camera_file trajectory_reader json_reader recording_reader map_file)
 TARGETS=("$@")
 [ ${#TARGETS[@]} -eq 0 ] && TARGETS=("${ALL_TARGETS[@]}")
 JOBS=$(nproc 2>/dev/null || echo 2)

@@ -4,6 +4,7 @@
 // keyframe covariances and statistics, and the ATE when ground truth is at hand. Default mode:
 // deterministic (lock-step, one thread): same input -> same output bytes.
 #include <atomic>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <memory>
@@ -14,10 +15,12 @@
 #include "drivers/synth/synth_spec.h"
 #include "drivers/trajectory/evaluate.h"
 #include "drivers/common/atomic_file.h"
+#include "drivers/common/skip_frames_source.h"
 #include "runtime/chrome_trace.h"
 #include "tools/args.h"
 #include "tools/command.h"
 #include "tools/io_plan.h"
+#include "tools/map_files.h"
 #include "tools/run_flags.h"
 #include "tools/run_outputs.h"
 
@@ -43,6 +46,13 @@ void printRunUsage() {
       "                       pose covariance from local BA (docs/ODOMETRY.md)\n"
       "  --stats FILE         statistics as JSON (states, keyframes, map, ms per frame, RSS, options)\n"
       "  --max-frames N       stop after N frames\n"
+      "  --skip-frames N      start at the source's frame N (the first N are read and discarded; 0..)\n"
+      "  --save-map FILE      at the end of the run (also after SIGINT), the loop closer's keyframe graph\n"
+      "                       and features as a versioned, checksummed map file (docs/LOOP.md \"Map\n"
+      "                       files\"); needs loop closing\n"
+      "  --load-map FILE      start in a saved map: frames are relocalized against its keyframes until\n"
+      "                       one succeeds (`# <t> lost` lines before that), then tracking continues in\n"
+      "                       the map's world frame; the map's camera must be this run's\n"
       "  --gt FILE            ground truth (TUM format): print the ATE RMSE (synthetic scenes: exact)\n"
       "  --synth-noise        synthetic scenes with Kinect-like depth and pixel noise\n"
       "  --output-delay N     frames held back so local BA refines them (default 60; 0 = as tracked)\n"
@@ -86,7 +96,8 @@ void onStopSignal(int signal) {
 int runRun(int argc, char** argv) {
   Args args(argc, argv,
             withScheduleFlags({"dataset", "camera", "out", "line-samples", "covariance", "stats", "max-frames",
-                               "gt", "output-delay", "rss-every", "mavlink", "report-every", "out-optimized"},
+                               "gt", "output-delay", "rss-every", "mavlink", "report-every", "out-optimized",
+                               "skip-frames", "save-map", "load-map"},
                               scheduleValueFlags()),
             withScheduleFlags({"no-lines", "synth-noise", "progress", "trace", "count-allocations", "discard-trajectory",
                                "no-loops"},
@@ -113,7 +124,15 @@ int runRun(int argc, char** argv) {
   const long output_delay = args.getInt("output-delay", 60, &ok);
   const long rss_every = args.getInt("rss-every", 0, &ok);
   const long report_every = args.getInt("report-every", 0, &ok);
-  if (!ok) return fail("--line-samples, --max-frames, --output-delay, --rss-every and --report-every take integers", kExitUsage);
+  const long skip_frames = args.getInt("skip-frames", 0, &ok);
+  if (!ok) {
+    return fail("--line-samples, --max-frames, --output-delay, --rss-every, --report-every and --skip-frames take integers",
+                kExitUsage);
+  }
+  if (skip_frames < 0) return fail("--skip-frames takes a count >= 0", kExitUsage);
+  if (args.has("save-map") && args.has("no-loops")) {
+    return fail("--save-map needs loop closing (the map is the loop closer's keyframe graph): drop --no-loops", kExitUsage);
+  }
   if (rss_every < 0 || report_every < 0) return fail("--rss-every and --report-every take counts >= 0", kExitUsage);
   if (!args.has("out") && !args.has("discard-trajectory")) {
     return fail("--out FILE is required (or --discard-trajectory to run without keeping the poses)", kExitUsage);
@@ -143,6 +162,8 @@ int runRun(int argc, char** argv) {
   io.addInput(args.get("dataset"));
   io.addInput(args.get("gt"));
   io.addInput(args.get("camera"));
+  io.addInput(args.get("load-map"));
+  io.addOutput("--save-map", args.get("save-map"));
   io.addOutput("--out", args.get("out"));
   io.addOutput("--covariance", args.get("covariance"));
   io.addOutput("--out-optimized", args.get("out-optimized"));
@@ -150,6 +171,19 @@ int runRun(int argc, char** argv) {
   io.addOutput("--profile", profile_path);
   st = io.check();
   if (!st.ok()) return fail(st.message(), kExitUsage);
+
+  // The map is read and checked before the source is opened: a bad map costs no set-up.
+  loop::SavedMap loaded_map;
+  double map_read_ms = 0;
+  if (args.has("load-map")) {
+    const auto read_start = std::chrono::steady_clock::now();
+    st = loadMapFile(args.get("load-map"), &loaded_map);
+    map_read_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - read_start).count();
+    if (!st.ok()) return fail(st.message());
+    run_options.load_map = &loaded_map;
+  }
+  loop::SavedMap saved_map;
+  if (args.has("save-map")) run_options.save_map = &saved_map;
 
   const std::string spec = args.get("dataset");
   std::unique_ptr<FrameSource> source;
@@ -164,6 +198,13 @@ int runRun(int argc, char** argv) {
     st = openFrameSource(spec, args.get("camera"), &source);
     if (!st.ok()) return fail(st.message());
     if (auto* synth = dynamic_cast<SyntheticSource*>(source.get())) scene = &synth->scene();
+  }
+  if (skip_frames > 0) source = std::make_unique<SkipFramesSource>(std::move(source), uint64_t(skip_frames));
+  if (args.has("load-map")) {
+    const std::string mismatch = loop::cameraMismatch(loaded_map.camera, source->camera());
+    if (!mismatch.empty()) {
+      return fail("map " + args.get("load-map") + " was made with another camera: " + mismatch);
+    }
   }
 
   RunOutputOptions output_options;
@@ -187,6 +228,15 @@ int runRun(int argc, char** argv) {
   st = runToOutputs(*source, system_options, run_options, outputs, &record);
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
+  // The map is written whatever ended the run (a stop, a read error): like the trajectory, it holds
+  // what was computed.
+  uint64_t map_bytes = 0;
+  if (args.has("save-map") && record.run.loop.enabled) {
+    const Status saved = saveMapFile(args.get("save-map"), saved_map, &map_bytes);
+    if (!saved.ok()) return fail(saved.message());
+    std::printf("map saved: %s, %zu keyframes, %zu loop edges, %llu bytes\n", args.get("save-map").c_str(),
+                saved_map.keyframes.size(), saved_map.loop_edges.size(), (unsigned long long)map_bytes);
+  }
   // A failed run still wrote every pose it computed (the runner finishes the system whatever ended
   // the run): say so, then fail.
   if (!st.ok()) {
@@ -211,7 +261,7 @@ int runRun(int argc, char** argv) {
     st = readTumTrajectory(args.get("gt"), &ground_truth).withContext("reading ground truth");
     if (!st.ok()) return fail(st.message());
   } else if (scene != nullptr) {
-    ground_truth = syntheticGroundTruth(*scene, long(statistics.frames() + statistics.framesDropped()));
+    ground_truth = syntheticGroundTruth(*scene, long(statistics.frames() + statistics.framesDropped()) + skip_frames);
   }
   double ate_optimized = -1;
   if (!ground_truth.empty() && output_options.keep_trajectory) {
@@ -273,6 +323,17 @@ int runRun(int argc, char** argv) {
                 (unsigned long long)rejected, (unsigned long long)ls.rejected[int(loop::LoopRejection::kImplausible)],
                 ls.optimisation_ms_total, (unsigned long long)loop.records_dropped);
   }
+  if (args.has("load-map")) {
+    const int64_t relocalized = record.odometry.loaded_map_relocalized_frame;
+    std::printf("map loaded: %s, %zu keyframes, %zu loop edges; read + checked in %.1f ms, restored in %.1f ms; ",
+                args.get("load-map").c_str(), loaded_map.keyframes.size(), loaded_map.loop_edges.size(), map_read_ms,
+                record.run.map_restore_ms);
+    if (relocalized >= 0) {
+      std::printf("relocalized at frame %lld\n", (long long)relocalized);
+    } else {
+      std::printf("never relocalized\n");
+    }
+  }
   if (ate >= 0) std::printf("ATE RMSE %.4f m\n", ate);
   if (ate_optimized >= 0) std::printf("ATE RMSE optimized %.4f m\n", ate_optimized);
   if (!profile_path.empty()) {
@@ -295,6 +356,15 @@ int runRun(int argc, char** argv) {
     summary.stop_signal = record.run.stopped ? int(g_stop_signal) : 0;
     summary.damaged_regions = damage.regions_skipped;
     summary.damage = damage.last;
+    summary.map_loaded = args.has("load-map");
+    summary.map_read_ms = map_read_ms;
+    summary.map_keyframes = loaded_map.keyframes.size();
+    summary.map_loop_edges = loaded_map.loop_edges.size();
+    if (args.has("save-map")) {
+      summary.map_saved_path = args.get("save-map");
+      summary.map_saved_keyframes = saved_map.keyframes.size();
+      summary.map_saved_bytes = map_bytes;
+    }
     st = writeFileAtomically(args.get("stats"), runSummaryJson(summary));
     if (!st.ok()) return fail(st.message());
   }

@@ -34,6 +34,7 @@
 #include "pipeline/loop/keyframe_database.h"
 #include "pipeline/loop/loop_keyframe.h"
 #include "pipeline/loop/loop_verifier.h"
+#include "pipeline/loop/saved_map.h"
 #include "pipeline/odometry/map_correction.h"
 #include "solver/pose_graph.h"
 
@@ -109,6 +110,14 @@ class LoopCloser {
   // End of a run: optimises once more if edges changed since the last optimisation (without any
   // loop edge this simply re-chains the refined odometry).
   void finalOptimise();
+
+  // Map files (docs/LOOP.md "Map files", loop_closer_map.cpp). exportMap: every record with its
+  // graph node and the loop edges (map->camera is the caller's). restoreMap: into an EMPTY closer,
+  // before any addKeyframe; the database is rebuilt from the records' descriptors. Refused (nothing
+  // changed) when the closer is not empty, the map exceeds capacity or max_loop_edges, or a
+  // covariance / information matrix is not positive definite.
+  void exportMap(SavedMap* map) const;
+  Status restoreMap(const SavedMap& map);
 
   // The graph's current pose of a keyframe (optimised after a loop); false if not in the graph.
   bool pose(uint32_t keyframe_id, Eigen::Isometry3d* T_world_cam) const;

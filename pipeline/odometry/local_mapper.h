@@ -77,6 +77,8 @@ class LocalMapper {
   // The snapshot published after the last insertion (version 0 before any).
   const LocalMap& localMap() const { return *local_map_; }
   const Map& map() const { return map_; }
+  // Keyframe ids from here on start at `id` or later (Map::setNextKeyframeId).
+  void setNextKeyframeId(uint32_t id) { map_.setNextKeyframeId(id); }
   const MapperStats& stats() const { return stats_; }
   uint32_t segment() const { return segment_; }
 

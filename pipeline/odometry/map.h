@@ -27,6 +27,9 @@ class Map {
  public:
   Map();
   void clear();
+  // Ids of keyframes added from now on start at `id` (a run continuing a loaded map numbers its
+  // keyframes after the map's). Only forward: ids are never reused.
+  void setNextKeyframeId(uint32_t id) { next_keyframe_id_ = id > next_keyframe_id_ ? id : next_keyframe_id_; }
 
   // --- slots ------------------------------------------------------------------------------------
   // Each returns the new slot, or -1 when the arrays are full (the caller retires something first).

@@ -20,6 +20,10 @@ struct OdometryStats {
   uint64_t output_overflows = 0;
   uint64_t loop_corrections_applied = 0;  // loop closing moved the local map
   uint64_t loop_corrections_stale = 0;    // its keyframe had left the map: not applied
+  // A run that started in a loaded map (--load-map): the 0-based index of the frame that
+  // relocalized into it (-1: not a loaded-map run, or never relocalized).
+  int64_t loaded_map_relocalized_frame = -1;
+  uint64_t loaded_map_keyframes = 0;  // keyframes the relocalizer got from the loaded map
 };
 
 }  // namespace plumb

@@ -125,6 +125,34 @@ void OdometrySystem::tryRelocalize(const FrameFeatures& features, MapperFence* f
   o.relocalized = true;
 }
 
+void OdometrySystem::addLoadedKeyframe(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam, std::size_t n,
+                                       const Descriptor256* descriptors, const Eigen::Vector3f* P_cam) {
+  relocalizer_->addStoredKeyframe(keyframe_id, T_world_cam, n, descriptors, P_cam);
+  ++mapping_.stats.loaded_map_keyframes;
+}
+
+void OdometrySystem::beginInLoadedMap(uint32_t first_new_id) {
+  mapping_.mapper->setNextKeyframeId(first_new_id);
+  tracking_.map_started = true;
+  tracking_.lost = true;
+  tracking_.awaiting_loaded_map = true;
+  tracking_.lost_streak = 0;
+}
+
+// The relocalized pose is in the loaded map's frame; the local map is empty, so it starts here (a
+// new map segment at that pose) instead of Tracker::resetAt against a map that has no landmarks.
+void OdometrySystem::tryRelocalizeIntoLoadedMap(const FrameFeatures& features, uint64_t sequence, double timestamp_s,
+                                                MapperFence* fence, TrackedFrame* out) {
+  if (fence != nullptr) fence->waitForMapper();
+  out->relocalization_attempted = true;
+  Eigen::Isometry3d T_world_cam;
+  const RelocResult r = relocalizer_->relocalize(features, &T_world_cam);
+  if (!r.success || !canStartMap(features)) return;
+  startMap(features, sequence, timestamp_s, T_world_cam, fence, out);
+  tracking_.awaiting_loaded_map = false;
+  out->output.relocalized = true;
+}
+
 void OdometrySystem::trackFeatures(const FrameFeatures& features, uint64_t sequence, double timestamp_s,
                                    MapperFence* fence, TrackedFrame* out) {
   const auto start = std::chrono::steady_clock::now();
@@ -165,6 +193,8 @@ void OdometrySystem::trackFeatures(const FrameFeatures& features, uint64_t seque
 
   if (!tracking_.map_started) {
     if (canStartMap(features)) startMap(features, sequence, timestamp_s, tracking_.T_world_last_good, fence, out);
+  } else if (tracking_.awaiting_loaded_map) {
+    tryRelocalizeIntoLoadedMap(features, sequence, timestamp_s, fence, out);
   } else if (tracking_.lost) {
     tryRelocalize(features, fence, out);
     if (!o.has_pose && ++tracking_.lost_streak >= options_.odometry.relocalizer.max_lost_frames_before_new_map &&
@@ -263,6 +293,9 @@ void OdometrySystem::recordOutput(const TrackedFrame& tracked) {
   ++mapping_.stats.frames;
   mapping_.stats.relocalization_attempts += tracked.relocalization_attempted;
   mapping_.stats.relocalizations += mapping_.output.relocalized;
+  if (mapping_.output.relocalized && mapping_.output.new_map && mapping_.stats.loaded_map_relocalized_frame < 0) {
+    mapping_.stats.loaded_map_relocalized_frame = int64_t(mapping_.stats.frames) - 1;  // frames counts this one
+  }
   mapping_.stats.segments += mapping_.output.new_map;
   mapping_.stats.keyframes += mapping_.output.keyframe;
   if (mapping_.output.track.used_motion_fallback) ++mapping_.stats.frames_motion_fallback;

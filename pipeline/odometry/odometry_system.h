@@ -91,6 +91,17 @@ class OdometrySystem {
   const PinholeCamera& camera() const { return camera_; }
   const SystemOptions& options() const { return options_; }
 
+  // A loaded map (--load-map, docs/LOOP.md "Map files"), before the first frame: the relocalizer
+  // gets the map's keyframes (addLoadedKeyframe, in its world frame), and beginInLoadedMap() puts
+  // the system in the "relocalize into the loaded map" state: every frame is relocalized against
+  // those keyframes (no pose, written `# <t> lost`, until one succeeds; no new map is started
+  // meanwhile), and the first that succeeds starts the local map at its relocalized pose, so
+  // tracking continues in the loaded map's frame. New keyframes get ids from `first_new_id` on
+  // (> every loaded id).
+  void addLoadedKeyframe(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam, std::size_t n,
+                         const Descriptor256* descriptors, const Eigen::Vector3f* P_cam);
+  void beginInLoadedMap(uint32_t first_new_id);
+
   // Tracking side. fence may be nullptr (never waits).
   void trackFeatures(const FrameFeatures& features, uint64_t sequence, double timestamp_s, MapperFence* fence,
                      TrackedFrame* out);
@@ -137,6 +148,7 @@ class OdometrySystem {
     std::unique_ptr<Tracker> tracker;
     bool map_started = false;
     bool lost = false;
+    bool awaiting_loaded_map = false;  // beginInLoadedMap(): relocalize, never start a new map
     int lost_streak = 0;
     Eigen::Isometry3d T_world_last_good = Eigen::Isometry3d::Identity();
     uint64_t keyframe_requests = 0;  // handed to mapFrame()
@@ -160,6 +172,8 @@ class OdometrySystem {
   void startMap(const FrameFeatures& features, uint64_t sequence, double timestamp_s,
                 const Eigen::Isometry3d& T_world_cam, MapperFence* fence, TrackedFrame* out);
   void tryRelocalize(const FrameFeatures& features, MapperFence* fence, TrackedFrame* out);
+  void tryRelocalizeIntoLoadedMap(const FrameFeatures& features, uint64_t sequence, double timestamp_s,
+                                  MapperFence* fence, TrackedFrame* out);
   // Mapping side.
   void insertKeyframe(const KeyframeRequest& request);
   void recordOutput(const TrackedFrame& tracked);

@@ -61,6 +61,21 @@ void Relocalizer::addKeyframe(uint32_t keyframe_id, const Eigen::Isometry3d& T_w
   }
 }
 
+void Relocalizer::addStoredKeyframe(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam, std::size_t n,
+                                    const Descriptor256* descriptors, const Eigen::Vector3f* P_cam) {
+  StoredKeyframe& kf = (*stored_)[next_];
+  next_ = (next_ + 1) % kMaxRelocKeyframes;
+  count_ = std::min(count_ + 1, kMaxRelocKeyframes);
+  kf.id = keyframe_id;
+  kf.T_world_cam = T_world_cam;
+  kf.descriptors.clear();
+  kf.P_cam.clear();
+  for (std::size_t i = 0; i < std::min(n, kMaxRelocFeatures); ++i) {
+    (void)kf.descriptors.push_back(descriptors[i]);
+    (void)kf.P_cam.push_back(P_cam[i]);
+  }
+}
+
 void Relocalizer::updatePose(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam) {
   for (std::size_t i = 0; i < count_; ++i) {
     if ((*stored_)[i].id == keyframe_id) (*stored_)[i].T_world_cam = T_world_cam;

@@ -39,6 +39,10 @@ class Relocalizer {
 
   // Remembers a keyframe (the oldest stored one is overwritten when the ring is full).
   void addKeyframe(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam, const FrameFeatures& frame);
+  // Remembers a keyframe of a loaded map from its stored features (n descriptors with their 3D
+  // points in the keyframe's camera frame; the first kMaxRelocFeatures are kept).
+  void addStoredKeyframe(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam, std::size_t n,
+                         const Descriptor256* descriptors, const Eigen::Vector3f* P_cam);
   // Replaces the pose of a stored keyframe (after local BA refined it); unknown ids are ignored.
   void updatePose(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam);
   std::size_t size() const { return count_; }

@@ -37,6 +37,8 @@ class LoopStage {
   LoopStage(const LoopStage&) = delete;
   LoopStage& operator=(const LoopStage&) = delete;
 
+  // Before start(): the loaded map's keyframes, graph and loop edges (LoopCloser::restoreMap).
+  Status restoreMap(const loop::SavedMap& map) { return closer_->restoreMap(map); }
   void start();  // threaded: starts the thread
   // Map stage thread, for every frame whose output says a keyframe was inserted.
   void keyframeInserted(const TrackedFrame& tracked, const FrameOutput& output);

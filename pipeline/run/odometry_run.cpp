@@ -3,6 +3,8 @@
 #include <opencv2/core/utility.hpp>
 
 #include <algorithm>
+#include <chrono>
+#include <string>
 
 #include "pipeline/run/loop_stage.h"
 #include "pipeline/run/odometry_stages.h"
@@ -19,6 +21,12 @@ Status validate(const OdometryRunOptions& options) {
   }
   if (options.max_frames_ahead_of_mapper < -1 || options.max_frames_ahead_of_mapper > 64) {
     return Status::Error("max_frames_ahead_of_mapper must be within 0..64 (or -1: by mode)");
+  }
+  if (options.save_map != nullptr && !options.loop_closing) {
+    return Status::Error("saving a map needs loop closing (the map is the loop closer's keyframe graph)");
+  }
+  if (options.load_map != nullptr && options.load_map->keyframes.empty()) {
+    return Status::Error("the loaded map holds no keyframes: nothing to relocalize against");
   }
   return Status::Ok();
 }
@@ -75,8 +83,32 @@ Status runOdometry(FrameCapture& capture, OdometrySystem& system, OdometrySink& 
     // the map as in deterministic mode: a correction then reaches the same frame's map as there,
     // which keeps fast mode's output the deterministic output.
     loop = std::make_unique<LoopStage>(system, options.loop, realtime && !simulated, realtime ? 5 : 0);
-    loop->start();
   }
+  if (options.load_map != nullptr) {
+    const auto restore_start = std::chrono::steady_clock::now();
+    const std::string mismatch = loop::cameraMismatch(options.load_map->camera, system.camera());
+    if (!mismatch.empty()) {
+      return Status::Error("the map was made with another camera: " + mismatch);
+    }
+    if (loop) PLUMB_RETURN_IF_ERROR(loop->restoreMap(*options.load_map).withContext("loading the map"));
+    // The relocalizer keeps its ring's worth (the newest keyframes when the map holds more).
+    std::vector<Eigen::Vector3f> points;
+    points.reserve(loop::kMaxLoopPoints);
+    for (const auto& k : options.load_map->keyframes) {
+      points.clear();
+      for (const loop::LoopPoint& p : k->record.points) points.push_back(p.P_cam);
+      system.addLoadedKeyframe(k->record.id, k->T_world_cam, points.size(), k->record.point_descriptors.data(),
+                               points.data());
+    }
+    // New keyframe ids leave a gap of the loop closer's minimum candidate age after the loaded
+    // ones: the closer skips candidates that young (the local window), but a loaded keyframe is
+    // never in this run's window, so the very first new keyframes may already close a loop into
+    // the loaded map (ids only need to grow).
+    system.beginInLoadedMap(options.load_map->maxKeyframeId() + 1 + uint32_t(std::max(0, options.loop.min_age_keyframes)));
+    result->map_restore_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - restore_start).count();
+  }
+  if (loop) loop->start();
   MapStage map(system, fence, drops, sink, options.warmup_frames, loop.get());
   runtime::StageRunner<OdometrySlot> runner(capture_stage, {&extract, &track, &map}, schedule);
   Status status = runner.run();
@@ -114,6 +146,10 @@ Status runOdometry(FrameCapture& capture, OdometrySystem& system, OdometrySink& 
       Eigen::Isometry3d T;
       const uint32_t id = loop->closer().idAt(i);
       if (loop->closer().pose(id, &T)) r.keyframes.emplace_back(id, T);
+    }
+    if (options.save_map != nullptr) {
+      loop->closer().exportMap(options.save_map);
+      options.save_map->camera = system.camera();
     }
   }
 

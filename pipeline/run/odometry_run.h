@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "pipeline/loop/loop_closer.h"
+#include "pipeline/loop/saved_map.h"
 #include "pipeline/odometry/odometry_system.h"
 #include "platform/status.h"
 #include "runtime/run_options.h"
@@ -80,6 +81,12 @@ struct OdometryRunOptions {
   // backs up into the slot pool and frames drop, counted). Lock-step never waits.
   int max_frames_ahead_of_mapper = -1;
   static constexpr int kRealtimeFramesAhead = 4;
+  // Map files (docs/LOOP.md "Map files"). load_map: the run starts relocalizing into this map (its
+  // camera must equal the system's; it needs at least one keyframe); its keyframes join the loop
+  // closer's graph when loop closing is on. save_map: filled at the end of the run (whatever ended
+  // it) with the loop closer's final graph and records and the system's camera; needs loop closing.
+  const loop::SavedMap* load_map = nullptr;
+  loop::SavedMap* save_map = nullptr;
 
   static runtime::RunOptions defaultSchedule() {
     runtime::RunOptions o;
@@ -122,6 +129,7 @@ struct OdometryRunResult {
   // baseline, so `allocation_frames` = frames counted after it.
   uint64_t allocation_frames = 0;
   uint64_t allocations_after_warmup = 0;
+  double map_restore_ms = 0;  // load_map: loop closer + relocalizer filled (before the first frame)
 };
 
 Status runOdometry(FrameCapture& capture, OdometrySystem& system, OdometrySink& sink,

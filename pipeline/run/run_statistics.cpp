@@ -122,6 +122,14 @@ std::string runSummaryJson(const RunSummary& r) {
                       "    \"edges_refined\": %" PRIu64 ", \"optimisations\": %" PRIu64 ", \"optimisation_ms_total\": %.3f, \"optimisation_ms_max\": %.3f},\n",
                       ls.edges_refined, ls.optimisations, ls.optimisation_ms_total, ls.optimisation_ms_max));
   }
+  if (r.map_loaded || !r.map_saved_path.empty()) {
+    add(std::snprintf(buf, sizeof(buf),
+                      "  \"map_file\": {\"loaded\": %s, \"load_read_ms\": %.3f, \"load_restore_ms\": %.3f, "
+                      "\"loaded_keyframes\": %" PRIu64 ", \"loaded_loop_edges\": %" PRIu64
+                      ", \"relocalized_frame\": %" PRId64 ", \"saved_keyframes\": %" PRIu64 ", \"saved_bytes\": %" PRIu64 "},\n",
+                      r.map_loaded ? "true" : "false", r.map_read_ms, r.run->map_restore_ms, r.map_keyframes,
+                      r.map_loop_edges, s.loaded_map_relocalized_frame, r.map_saved_keyframes, r.map_saved_bytes));
+  }
   out += "  \"rss_checkpoints\": [";
   const std::vector<RssCheckpoint>& rss = r.statistics->rss();
   for (std::size_t i = 0; i < rss.size(); ++i) {

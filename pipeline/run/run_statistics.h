@@ -57,6 +57,14 @@ struct RunSummary {
   int stop_signal = 0;  // the signal that stopped the run early (0: it was not stopped by one)
   uint64_t damaged_regions = 0;  // input regions the source skipped as damaged
   std::string damage;            // the last damage it reported
+  // Map files (--load-map / --save-map): a "map_file" object only when one was used, so the
+  // statistics of other runs are unchanged. Milliseconds: reading + checking + decoding the file,
+  // and filling the loop closer and relocalizer.
+  bool map_loaded = false;
+  double map_read_ms = 0;
+  uint64_t map_keyframes = 0, map_loop_edges = 0;
+  std::string map_saved_path;
+  uint64_t map_saved_keyframes = 0, map_saved_bytes = 0;
 };
 std::string runSummaryJson(const RunSummary& summary);
 
