@@ -16,6 +16,27 @@ bool positiveDefinite(const Matrix6d& m) {
   return llt.info() == Eigen::Success;
 }
 
+// The closer keeps only a keyframe's LoopCandidate (what verification and relocalization read):
+// the record written to a map file carries those features; the query-only fields (pixel, u_right,
+// octave, the 2D line) are written as zero and the record's header from the graph node.
+void recordOfCandidate(const LoopCandidate& c, LoopKeyframe* r) {
+  r->clearFeatures();
+  r->id = c.id;
+  for (std::size_t k = 0; k < c.num_points; ++k) {
+    LoopPoint p;
+    p.P_cam = c.P_cam[k];
+    (void)r->points.push_back(p);
+    (void)r->point_descriptors.push_back(c.point_descriptors[k]);
+  }
+  for (std::size_t k = 0; k < c.num_lines; ++k) {
+    LoopLine line;
+    line.num_samples = c.num_samples[k];
+    for (std::size_t s = 0; s < line.num_samples; ++s) line.samples_cam[s] = c.samples_cam[c.first_sample[k] + s];
+    (void)r->lines.push_back(line);
+    (void)r->line_descriptors.push_back(c.line_descriptors[k]);
+  }
+}
+
 }  // namespace
 
 void LoopCloser::exportMap(SavedMap* map) const {
@@ -24,7 +45,10 @@ void LoopCloser::exportMap(SavedMap* map) const {
   for (int slot : order_) {
     const Node& n = nodes_[std::size_t(slot)];
     auto k = std::make_unique<SavedKeyframe>();
-    k->record = records_[std::size_t(slot)];
+    recordOfCandidate(records_[std::size_t(slot)], &k->record);
+    k->record.T_world_cam = n.T_world_record;
+    k->record.previous_id = n.previous_map_id;
+    k->record.T_previous_this = n.T_previous_this;
     k->T_world_cam = n.T_world_cam;
     k->has_edge = n.has_edge;
     k->T_previous_this = n.T_previous_this;
@@ -69,21 +93,22 @@ Status LoopCloser::restoreMap(const SavedMap& map) {
     const SavedKeyframe& k = *kp;
     const int slot = free_slots_.back();
     free_slots_.pop_back();
-    records_[std::size_t(slot)] = k.record;
+    makeLoopCandidate(k.record, &records_[std::size_t(slot)]);
     Node& n = nodes_[std::size_t(slot)];
     n = Node{};
     n.id = k.record.id;
     n.T_world_cam = k.T_world_cam;
+    n.T_world_record = k.record.T_world_cam;
     n.has_edge = k.has_edge;
     n.T_previous_this = k.T_previous_this;
     n.edge_covariance = k.edge_covariance;
     n.edge_length_m = k.edge_length_m;
     n.previous_map_id = k.previous_map_id;
     order_.push_back(slot);
-    const LoopKeyframe& r = records_[std::size_t(slot)];
+    const LoopCandidate& r = records_[std::size_t(slot)];
     // Sized for capacity + 1 keyframes of at most kMaxLoopPoints + kMaxLoopLines words: cannot fail.
-    (void)database_.insert(r.id, PlaceDescriptors{r.point_descriptors.data(), r.point_descriptors.size(),
-                                                  r.line_descriptors.data(), r.line_descriptors.size()});
+    (void)database_.insert(r.id, PlaceDescriptors{r.point_descriptors.data(), r.num_points,
+                                                  r.line_descriptors.data(), r.num_lines});
   }
   for (const SavedLoopEdge& e : map.loop_edges) {
     loop_edges_.push_back(LoopEdge{e.candidate_id, e.query_id, e.T_candidate_query, e.information});

@@ -105,6 +105,25 @@ inline void makeExampleMap(uint64_t seed, int keyframes, int points, int lines, 
       (void)r.lines.push_back(ll);
       (void)r.line_descriptors.push_back(randomDescriptor(g));
     }
+    // What a loop closer keeps of a record (its LoopCandidate and graph node) is all a map file
+    // can give back: the header fields and the query-only feature fields are not kept, so a map
+    // exported by a closer has them at their defaults (docs/LOOP.md "Map files"). The example is
+    // made the same way, so that a round trip through a closer is byte-exact.
+    r.frame_sequence = 0;
+    r.timestamp_s = 0;
+    r.new_segment = false;
+    r.covariance.setZero();
+    r.covariance_valid = false;
+    r.T_previous_this = k->T_previous_this;
+    for (loop::LoopPoint& lp : r.points) {
+      lp.px.setZero();
+      lp.u_right = 0;
+      lp.octave = 0;
+    }
+    for (loop::LoopLine& ll : r.lines) {
+      ll.l.setZero();
+      ll.octave = 0;
+    }
     map->keyframes.push_back(std::move(k));
   }
   for (int e = 0; e < loop_edges && keyframes >= 2; ++e) {
