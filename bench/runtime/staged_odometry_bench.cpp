@@ -245,7 +245,7 @@ int main(int argc, char** argv) {
       p99_loops.push_back(p99Ms(rb));
     }
     std::printf("realtime repeat %d: p99 end to end %.2f ms with loop closing, %.2f ms without\n", run + 1,
-                p99_loops.back(), p99_no_loops.back());
+                p99_loops[std::size_t(run)], p99_no_loops[std::size_t(run)]);
   }
   auto median = [](std::vector<double> v) {
     std::sort(v.begin(), v.end());
