@@ -38,8 +38,7 @@ void Relocalizer::ScratchDeleter::operator()(Scratch* s) const {
   ZeroPageAllocator<Scratch>().deallocate(s, 1);
 }
 
-void Relocalizer::addKeyframe(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam,
-                              const FrameFeatures& frame) {
+Relocalizer::StoredKeyframe& Relocalizer::claimSlot(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam) {
   StoredKeyframe& kf = (*stored_)[next_];
   next_ = (next_ + 1) % kMaxRelocKeyframes;
   count_ = std::min(count_ + 1, kMaxRelocKeyframes);
@@ -47,6 +46,12 @@ void Relocalizer::addKeyframe(uint32_t keyframe_id, const Eigen::Isometry3d& T_w
   kf.T_world_cam = T_world_cam;
   kf.descriptors.clear();
   kf.P_cam.clear();
+  return kf;
+}
+
+void Relocalizer::addKeyframe(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam,
+                              const FrameFeatures& frame) {
+  StoredKeyframe& kf = claimSlot(keyframe_id, T_world_cam);
   // The strongest keypoints with depth (index breaks response ties: deterministic).
   auto& order = s_->order;
   order.clear();
@@ -63,13 +68,7 @@ void Relocalizer::addKeyframe(uint32_t keyframe_id, const Eigen::Isometry3d& T_w
 
 void Relocalizer::addStoredKeyframe(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam, std::size_t n,
                                     const Descriptor256* descriptors, const Eigen::Vector3f* P_cam) {
-  StoredKeyframe& kf = (*stored_)[next_];
-  next_ = (next_ + 1) % kMaxRelocKeyframes;
-  count_ = std::min(count_ + 1, kMaxRelocKeyframes);
-  kf.id = keyframe_id;
-  kf.T_world_cam = T_world_cam;
-  kf.descriptors.clear();
-  kf.P_cam.clear();
+  StoredKeyframe& kf = claimSlot(keyframe_id, T_world_cam);
   for (std::size_t i = 0; i < std::min(n, kMaxRelocFeatures); ++i) {
     (void)kf.descriptors.push_back(descriptors[i]);
     (void)kf.P_cam.push_back(P_cam[i]);

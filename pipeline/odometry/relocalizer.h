@@ -63,6 +63,8 @@ class Relocalizer {
     Eigen::Vector3d P_stored;       // stored keyframe camera frame
   };
 
+  // The next slot of the ring (the oldest keyframe gives way), emptied and given id and pose.
+  StoredKeyframe& claimSlot(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam);
   int countMatches(const StoredKeyframe& kf, const FrameFeatures& frame) const;
   int matchAll(const StoredKeyframe& kf, const FrameFeatures& frame);
   bool ransac(Eigen::Isometry3d* T_stored_current, int* inliers);
