@@ -72,16 +72,6 @@ py::array_t<double> matrixToNumpy(const double* column_major, int rows, int cols
 
 py::object poseToNumpy(const Eigen::Isometry3d& T) { return matrixToNumpy(T.matrix().data(), 4, 4); }
 
-Eigen::Isometry3d poseFromNumpy(const py::handle& object) {
-  const py::array_t<double, py::array::c_style | py::array::forcecast> a = py::array::ensure(object);
-  if (!a || a.ndim() != 2 || a.shape(0) != 4 || a.shape(1) != 4) throw py::value_error("a pose must be a 4x4 array");
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  auto m = a.unchecked<2>();
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 4; ++c) T.matrix()(r, c) = m(r, c);
-  return T;
-}
-
 api::CameraValues cameraFromDict(const py::dict& d) {
   api::CameraValues v;
   for (auto item : d) {

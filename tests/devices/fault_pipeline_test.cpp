@@ -21,7 +21,6 @@ TEST(FaultPipeline, TrajectoryContinuesAfterReconnection) {
   std::unique_ptr<SyntheticSource> rendered;
   ASSERT_TRUE(SyntheticSource::create(synth, &rendered).ok());
   const SyntheticScene& scene = rendered->scene();
-  const PinholeCamera camera = rendered->camera();
 
   auto faulty = std::make_unique<FaultInjectingSource>(
       std::move(rendered), std::vector<FaultEvent>{

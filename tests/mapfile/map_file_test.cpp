@@ -143,7 +143,9 @@ TEST(MapFile, EveryTruncationIsRefused) {
     loop::SavedMap out;
     const Status st = parseAndDecode(bytes.data(), size, &out);
     ASSERT_FALSE(st.ok()) << "truncated to " << size << " bytes was accepted";
-    if (size >= kMapFileHeaderBytes) EXPECT_NE(st.message().find("truncated"), std::string::npos) << st.message();
+    if (size >= kMapFileHeaderBytes) {
+      EXPECT_NE(st.message().find("truncated"), std::string::npos) << st.message();
+    }
   }
   loop::SavedMap whole;
   EXPECT_TRUE(parseAndDecode(bytes.data(), bytes.size(), &whole).ok());

@@ -43,7 +43,7 @@ TEST(JsonReader, RefusesHostileNesting) {
 // skipped as whitespace, because strchr(" \t\r\n", c) also matches the terminating NUL.
 TEST(JsonReader, RefusesNulBytesOutsideStrings) {
   JsonValue v;
-  for (const std::string bad : {std::string("[1,\0 2]", 7), std::string("\0{}", 3), std::string("{}\0", 3),
+  for (const std::string& bad : {std::string("[1,\0 2]", 7), std::string("\0{}", 3), std::string("{}\0", 3),
                                 std::string("{\"a\":\0 1}", 9)}) {
     EXPECT_FALSE(parseJson(bad, &v).ok()) << "accepted a NUL byte at offset " << bad.find('\0');
   }

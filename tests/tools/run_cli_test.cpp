@@ -39,7 +39,9 @@ TEST(RunOptionsValidation, EveryOtherSampleCountIsAccepted) {
     setLineSamples(n, true, &options.odometry);
     EXPECT_TRUE(validate(options).ok()) << n << ": " << validate(options).message();
     EXPECT_EQ(options.odometry.tracker.use_lines, n > 0) << n;
-    if (n >= 2) EXPECT_LE(options.odometry.extractor.min_line_inliers, n) << n;
+    if (n >= 2) {
+      EXPECT_LE(options.odometry.extractor.min_line_inliers, n) << n;
+    }
   }
 }
 
@@ -151,7 +153,7 @@ TEST_F(RunDataSafety, OutputOverAFileOfTheInputFolderIsRefused) {
 
 TEST_F(RunDataSafety, BadOutputPathsAreRefusedBeforeAnyWork) {
   const std::string out = dir_.file("t.txt");
-  for (const std::string extra : {std::string("--stats /nonexistent/folder/s.json"),
+  for (const std::string& extra : {std::string("--stats /nonexistent/folder/s.json"),
                                   std::string("--profile /nonexistent/p.json"),
                                   "--covariance '" + dir_.file("") + "'"}) {
     const RunResult r = runPlumb("run --dataset '" + dataset_ + "' --out '" + out + "' " + extra);
