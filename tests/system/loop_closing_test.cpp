@@ -81,7 +81,8 @@ TEST(LoopClosing, RepeatedCorridorAcceptsNoLoop) {
 
 // A starved CPU, made reproducible: the map stage sleeps on every frame (twice as long on a
 // keyframe), so a threaded tracker that did not wait would track against an old map. Fast mode
-// must still write lock-step's bytes, loop corrections included.
+// must still write lock-step's bytes, loop corrections included, and lock-step must write the same
+// bytes run after run (three runs with loops, one output).
 TEST(LoopClosing, FastModeWritesTheDeterministicBytesWhileTheMapStageLags) {
   const OdometryRun lock_step = runScene(shortLoop(), true, nullptr);
   RunSettings slow;
@@ -90,7 +91,11 @@ TEST(LoopClosing, FastModeWritesTheDeterministicBytesWhileTheMapStageLags) {
     std::this_thread::sleep_for(std::chrono::milliseconds(out.keyframe ? 6 : 3));
   };
   const OdometryRun fast = runScene(shortLoop(), true, nullptr, slow);
-  ASSERT_TRUE(lock_step.status.ok() && fast.status.ok());
+  const OdometryRun lock_step_again = runScene(shortLoop(), true, nullptr);
+  ASSERT_TRUE(lock_step.status.ok() && fast.status.ok() && lock_step_again.status.ok());
+  // Three runs, one output: lock-step twice (run after run) and fast with a lagging map stage.
+  EXPECT_TRUE(sameTrajectory(lock_step_again.trajectory, lock_step.trajectory));
+  EXPECT_TRUE(sameTrajectory(lock_step_again.optimized, lock_step.optimized));
   ASSERT_GE(lock_step.stats.loop_corrections_applied, 1u) << "the scene must close a loop for this test";
   EXPECT_EQ(fast.stats.loop_corrections_applied, lock_step.stats.loop_corrections_applied);
   EXPECT_TRUE(sameTrajectory(fast.trajectory, lock_step.trajectory));
