@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <ctime>
 #include <cstdio>
 #include <memory>
 #include <set>
@@ -82,15 +83,30 @@ int fail(const std::string& message, int code = kExitFailed) {
 }
 
 // SIGINT / SIGTERM: the capture stops reading, the frames already read finish, and every pose
-// reaches the outputs. A second signal while stopping is the default action (the outputs' temporary
-// files are then left, never a partial file under an output's name).
+// reaches the outputs. A second signal more than a second after the first is the default action
+// (the outputs' temporary files are then left, never a partial file under an output's name). One
+// within the second is the same request: `timeout -s INT` sends its signal to the process AND to
+// its process group, so a stopped run sees two at once (a run under ASan was killed by the second).
 std::atomic<bool> g_stop_requested{false};
 volatile std::sig_atomic_t g_stop_signal = 0;
+std::atomic<int64_t> g_first_stop_ns{0};
+
+int64_t monotonicNs() {  // clock_gettime is async-signal-safe
+  timespec t{};
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return int64_t(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
+}
 
 void onStopSignal(int signal) {
-  g_stop_signal = signal;
-  g_stop_requested.store(true);
+  const int64_t now = monotonicNs();
+  int64_t first = 0;
+  if (g_first_stop_ns.compare_exchange_strong(first, now) || now - first < 1'000'000'000) {
+    g_stop_signal = signal;
+    g_stop_requested.store(true);
+    return;
+  }
   std::signal(signal, SIG_DFL);
+  std::raise(signal);
 }
 
 int runRun(int argc, char** argv) {
