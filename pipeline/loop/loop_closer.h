@@ -144,12 +144,8 @@ class LoopCloser {
     uint64_t final_epoch = 0;
     Eigen::Isometry3d T_world_final = Eigen::Isometry3d::Identity();
   };
-  struct LoopEdge {
-    uint32_t candidate_id = 0;
-    uint32_t query_id = 0;
-    Eigen::Isometry3d T_candidate_query = Eigen::Isometry3d::Identity();
-    Matrix6d information = Matrix6d::Identity();
-  };
+  // A loop edge is what a map file stores of it (saved_map.h): one type, copied as is.
+  using LoopEdge = SavedLoopEdge;
   struct Group {
     uint32_t id = 0;
     int count = 0;

@@ -57,10 +57,7 @@ void LoopCloser::exportMap(SavedMap* map) const {
     k->previous_map_id = n.previous_map_id;
     map->keyframes.push_back(std::move(k));
   }
-  map->loop_edges.clear();
-  for (const LoopEdge& e : loop_edges_) {
-    map->loop_edges.push_back(SavedLoopEdge{e.candidate_id, e.query_id, e.T_candidate_query, e.information});
-  }
+  map->loop_edges = loop_edges_;
 }
 
 Status LoopCloser::restoreMap(const SavedMap& map) {
@@ -110,9 +107,7 @@ Status LoopCloser::restoreMap(const SavedMap& map) {
     (void)database_.insert(r.id, PlaceDescriptors{r.point_descriptors.data(), r.num_points,
                                                   r.line_descriptors.data(), r.num_lines});
   }
-  for (const SavedLoopEdge& e : map.loop_edges) {
-    loop_edges_.push_back(LoopEdge{e.candidate_id, e.query_id, e.T_candidate_query, e.information});
-  }
+  loop_edges_.insert(loop_edges_.end(), map.loop_edges.begin(), map.loop_edges.end());
   stats_.graph_nodes = order_.size();
   stats_.peak_graph_nodes = std::max<uint64_t>(stats_.peak_graph_nodes, order_.size());
   stats_.loop_edges = loop_edges_.size();
