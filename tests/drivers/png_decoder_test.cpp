@@ -168,6 +168,25 @@ TEST(PngDecoder, CorruptionIsAnErrorNotNoise) {
   EXPECT_EQ(maxDifference(out, depth), 0.0);
 }
 
+// Found by the png_decoder fuzz target: a text chunk whose length field claims 1.8 GB in a file of
+// a few dozen bytes made libpng malloc 1.8 GB before finding that the file ends. Now the claim is
+// refused against the file's size, from the arena, with a message.
+TEST(PngDecoder, ChunkLengthBeyondTheFileIsRefusedWithoutAllocatingIt) {
+  std::vector<uint8_t> bytes = encode(cv::Mat(1, 1, CV_8UC1, cv::Scalar(9)));
+  const std::size_t after_ihdr = 8 + 4 + 4 + 13 + 4;  // signature, IHDR length, type, data, CRC
+  const std::vector<uint8_t> huge_text = {0x6e, 0x74, 0x00, 0x00, 't', 'E', 'X', 't', 'C', 'o', 'm', 'm', 0};
+  bytes.insert(bytes.begin() + long(after_ihdr), huge_text.begin(), huge_text.end());
+  PngDecoder decoder;
+  PngHeader header;
+  EXPECT_FALSE(decoder.readHeader(bytes.data(), bytes.size(), &header));
+  EXPECT_NE(std::string(decoder.error()).find("corrupt"), std::string::npos) << decoder.error();
+  EXPECT_EQ(decoder.arenaOverflows(), 0u);  // before the fix: one 1.8 GB malloc
+  // The decoder still reads a good file afterwards.
+  cv::Mat out;
+  ASSERT_TRUE(decode(decoder, encode(cv::Mat(2, 3, CV_8UC1, cv::Scalar(4))), out)) << decoder.error();
+  EXPECT_EQ(out.at<uint8_t>(1, 2), 4);
+}
+
 TEST(PngDecoder, SecondDecodeIntoTheSameMatAllocatesNothing) {
   cv::Mat colour(480, 640, CV_8UC3);
   cv::randu(colour, 0, 255);
