@@ -6,6 +6,9 @@
 # build-fuzz/artifacts/<target>/).
 # Exit status 1 when any target crashed or broke an invariant, 2 when clang/libFuzzer is missing.
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     e.g. scripts/fuzz.sh 600 png_decoder
+# FUZZ_SEED=N fixes libFuzzer's random seed (-seed=N): the same inputs in the same order, so a CI
+# run that passed on a commit passes again (a faster machine only explores further). Unset: a
+# fresh seed per run, for the long runs that look for new findings.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_PER_TARGET=${1:-60}
@@ -37,10 +40,11 @@ for t in "${TARGETS[@]}"; do
   work="$probe/$t"
   mkdir -p "$work/corpus" "build-fuzz/artifacts/$t"
   cp fuzz/corpus/"$t"/* "$work/corpus/"
-  dict=()
-  [ -f "fuzz/dict/$t.dict" ] && dict=(-dict="fuzz/dict/$t.dict")
+  extra=()  # dictionary, seed
+  [ -f "fuzz/dict/$t.dict" ] && extra=(-dict="fuzz/dict/$t.dict")
+  [ -n "${FUZZ_SEED:-}" ] && extra+=(-seed="$FUZZ_SEED")
   ./build-fuzz/fuzz_"$t" -max_total_time="$SECONDS_PER_TARGET" -print_final_stats=1 -timeout=10 \
-    "${dict[@]}" -artifact_prefix="build-fuzz/artifacts/$t/" "$work/corpus" >"$work/log" 2>&1
+    "${extra[@]}" -artifact_prefix="build-fuzz/artifacts/$t/" "$work/corpus" >"$work/log" 2>&1
   rc=$?
   # The last status line ("#N DONE cov: C ft: F corp: K/B ...") holds the final coverage.
   status=$(grep -E '^#[0-9]+' "$work/log" | tail -1)

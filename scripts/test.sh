@@ -4,7 +4,8 @@
 #   2. platform/ and runtime/ tests again under ThreadSanitizer (lock-free code);
 #   3. AddressSanitizer + UBSan (-O1, scripts/sanitize.sh's asan-fast preset): every test binary
 #      except the system area's long replays (`bash scripts/sanitize.sh` runs all of them);
-#   4. every parser's libFuzzer target for 20 s each (scripts/fuzz.sh; skipped without clang).
+#   4. every parser's libFuzzer target for 20 s each with a fixed seed (scripts/fuzz.sh; skipped
+#      without clang).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 JOBS=$(nproc 2>/dev/null || echo 2)
@@ -24,7 +25,7 @@ PRESET=asan-fast bash scripts/sanitize.sh platform runtime solver pipeline odome
 
 echo "== Fuzzing: every parser, 20 s each (scripts/fuzz.sh) =="
 if command -v clang++ >/dev/null 2>&1; then
-  bash scripts/fuzz.sh 20
+  FUZZ_SEED=1 bash scripts/fuzz.sh 20
 else
   echo "skipped: clang++ not found (scripts/install_deps.sh installs clang and libclang-rt-14-dev)"
 fi
