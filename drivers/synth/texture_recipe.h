@@ -6,6 +6,7 @@
 // depend on which faces a frame sees) and paint a face only when a frame first sees it
 // (baked_textures.h). paintTexture replays the operations in order on a blank image, so a recipe
 // gives the same texels as drawing straight away did.
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -58,6 +59,15 @@ class TextureCanvas {
 };
 
 struct TextureRecipe {
+  TextureRecipe() = default;
+  TextureRecipe(const TextureRecipe&) = default;
+  TextureRecipe& operator=(const TextureRecipe&) = default;
+  TextureRecipe& operator=(TextureRecipe&&) = default;
+  // cv::Mat's move constructor is not declared noexcept (OpenCV 4.6), so without this std::vector
+  // COPIED every recipe (ops and all) each time a scene's recipe list grew: ~500 page faults and
+  // a few ms before the first synthetic frame. Moving a Mat only hands over its pointers.
+  TextureRecipe(TextureRecipe&& other) noexcept { *this = std::move(other); }
+
   int rows = 2, cols = 2;
   double texels_per_metre = 0;
   cv::Scalar base_bgr;           // the whole image starts in this colour
