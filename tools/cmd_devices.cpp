@@ -15,8 +15,10 @@
 
 namespace {
 
+#ifdef PLUMB_HAVE_LIBUSB  // only the hot-plug watch below stops on Ctrl-C
 volatile std::sig_atomic_t g_stop_requested = 0;
 void requestStop(int) { g_stop_requested = 1; }
+#endif
 
 void printHelp() {
   std::printf(
