@@ -6,7 +6,6 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
-#include <ctime>
 #include <cstdio>
 #include <memory>
 #include <set>
@@ -17,6 +16,7 @@
 #include "drivers/trajectory/evaluate.h"
 #include "drivers/common/atomic_file.h"
 #include "drivers/common/skip_frames_source.h"
+#include "platform/monotonic_time.h"
 #include "runtime/chrome_trace.h"
 #include "tools/args.h"
 #include "tools/command.h"
@@ -91,14 +91,8 @@ std::atomic<bool> g_stop_requested{false};
 volatile std::sig_atomic_t g_stop_signal = 0;
 std::atomic<int64_t> g_first_stop_ns{0};
 
-int64_t monotonicNs() {  // clock_gettime is async-signal-safe
-  timespec t{};
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return int64_t(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
-}
-
 void onStopSignal(int signal) {
-  const int64_t now = monotonicNs();
+  const int64_t now = monotonicNowNs();  // clock_gettime: async-signal-safe
   int64_t first = 0;
   if (g_first_stop_ns.compare_exchange_strong(first, now) || now - first < 1'000'000'000) {
     g_stop_signal = signal;
