@@ -83,9 +83,14 @@ void PoseGraph::reserveChainWithExtraEdges(int max_extra_edges) {
   H_.resize(dim, dim);
   const Eigen::Index h_entries = 21 * Eigen::Index(max_nodes_) + 36 * Eigen::Index(max_edges_);
   H_.resizeNonZeros(h_entries);
-  std::fill(H_.valuePtr(), H_.valuePtr() + h_entries, 0.0);  // resident from now on (header)
-  std::fill(H_.innerIndexPtr(), H_.innerIndexPtr() + h_entries, 0);
   factorization_.reserveFactor(dim, chainFactorEntries(max_nodes_, max_extra_edges));
+}
+
+std::array<PoseGraph::ReservedRange, 4> PoseGraph::reservedRanges() {
+  const std::size_t h_entries = std::size_t(H_.data().allocatedSize());
+  return {ReservedRange{H_.valuePtr(), h_entries * sizeof(double)},
+          ReservedRange{H_.innerIndexPtr(), h_entries * sizeof(int)}, factorization_.reservedValues(),
+          factorization_.reservedIndices()};
 }
 
 void PoseGraph::clear() {

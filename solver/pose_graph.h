@@ -50,6 +50,8 @@
 // allocates with (tests/solver/malloc replaces malloc to prove it; an operator-new hook would not
 // see Eigen's allocations).
 #include <algorithm>
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -121,9 +123,17 @@ class PoseGraph {
   // fills little) and H and the factor get storage for that bound here, once, so a later analyze()
   // makes no operator-new allocation (Eigen's sparse arrays are new[]; the outer index arrays
   // and small dense vectors it still sizes use malloc). A graph beyond the bound still works
-  // (Eigen reallocates). The reserved arrays are written here (zeros), so they are resident from
-  // the start: a long run's memory does not grow as loops fill the factor.
+  // (Eigen reallocates). The reserved arrays are not written here: the owner makes
+  // reservedRanges() resident when it chooses (the loop closer: a slice per keyframe after the
+  // first, platform/memory_residency.h), so a long run's memory does not grow as loops fill the
+  // factor, and the first frame does not pay for it.
   void reserveChainWithExtraEdges(int max_extra_edges);
+  // The arrays reserveChainWithExtraEdges() reserved: H's and the factor's values and indices.
+  struct ReservedRange {
+    void* data = nullptr;
+    std::size_t bytes = 0;
+  };
+  std::array<ReservedRange, 4> reservedRanges();
   // The factor entries reserveChainWithExtraEdges() reserves: the most a chain of max_nodes with
   // max_extra_edges extra edges can fill in the natural order (derivation in the .cpp; tight when
   // every extra edge spans the whole chain). H and the factor cost 12 bytes an entry.
@@ -196,9 +206,12 @@ class PoseGraph {
     void reserveFactor(Eigen::Index size, Eigen::Index nnz) {
       m_matrix.resize(size, size);
       m_matrix.resizeNonZeros(nnz);
-      // Written once so the pages are resident now, not when a long run's loops fill the factor.
-      std::fill(m_matrix.valuePtr(), m_matrix.valuePtr() + nnz, 0.0);
-      std::fill(m_matrix.innerIndexPtr(), m_matrix.innerIndexPtr() + nnz, 0);
+    }
+    ReservedRange reservedValues() {
+      return {m_matrix.valuePtr(), std::size_t(m_matrix.data().allocatedSize()) * sizeof(double)};
+    }
+    ReservedRange reservedIndices() {
+      return {m_matrix.innerIndexPtr(), std::size_t(m_matrix.data().allocatedSize()) * sizeof(int)};
     }
     void factorizeOrdered(const Eigen::SparseMatrix<double>& H_upper) { factorize_preordered<true>(H_upper); }
     // analyzePattern() without its copy of the input into a temporary (new[] every call): the

@@ -28,11 +28,10 @@ KeyframeDatabase::KeyframeDatabase(const KeyframeDatabaseOptions& options) : opt
   assert(validate(options).ok());
   num_words_total_ = std::size_t(2) << options.bits_per_word;
   word_head_.assign(num_words_total_, kNone);
-  postings_.resize(std::size_t(options.max_postings));
-  // Free postings chained in index order, so the first insert uses postings 0, 1, 2, ...
-  for (std::size_t i = 0; i < postings_.size(); ++i)
-    postings_[i].next_in_keyframe = i + 1 < postings_.size() ? uint32_t(i + 1) : kNone;
-  free_posting_head_ = 0;
+  postings_.resize(std::size_t(options.max_postings));  // zero pages, not written (header)
+  // The first inserts take postings 0, 1, 2, ... in order; removed ones are chained for reuse.
+  free_posting_head_ = kNone;
+  fresh_postings_ = 0;
   free_postings_ = postings_.size();
   slots_.resize(std::size_t(options.max_keyframes));
   free_slots_.reserve(slots_.size());
@@ -108,9 +107,13 @@ Status KeyframeDatabase::insertHistogram(uint64_t keyframe_id, const WordCount* 
   // Append in word order to the keyframe's chain (keyframeWords() then reads it sorted).
   uint32_t* link = &slot.first_posting;
   for (std::size_t i = 0; i < num_words; ++i) {
-    const uint32_t p = free_posting_head_;
+    uint32_t p = free_posting_head_;
+    if (p != kNone) {
+      free_posting_head_ = postings_[p].next_in_keyframe;
+    } else {
+      p = fresh_postings_++;  // free_postings_ >= num_words was checked: one is left
+    }
     Posting& posting = postings_[p];
-    free_posting_head_ = posting.next_in_keyframe;
     posting.word = words[i].word;
     posting.count = uint16_t(words[i].count);  // <= the kind's descriptor limit (<= 65535)
     posting.slot = uint16_t(slot_index);

@@ -36,7 +36,9 @@
 #include "pipeline/frontend/frame_features.h"
 #include "pipeline/loop/place_words.h"
 #include "platform/fixed_vector.h"
+#include "platform/memory_residency.h"
 #include "platform/status.h"
+#include "solver/zero_page_allocator.h"
 
 namespace plumb::loop {
 
@@ -120,6 +122,8 @@ class KeyframeDatabase {
 
   // Bytes held by the database (the object and every buffer it allocated at construction).
   std::size_t memoryBytes() const;
+  // Queues the postings array (the part of memoryBytes() not written at construction).
+  void queueReservedMemory(ResidencyQueue* queue) { queue->add(postings_.data(), postings_.size() * sizeof(Posting)); }
   // The same figure for given options, without building a database.
   static std::size_t memoryBytesFor(const KeyframeDatabaseOptions& options);
 
@@ -162,8 +166,12 @@ class KeyframeDatabase {
   std::size_t num_words_total_ = 0;  // 2 * 2^K
 
   std::vector<uint32_t> word_head_;       // per word: first posting, kNone if empty
-  std::vector<Posting> postings_;
-  uint32_t free_posting_head_ = kNone;  // free postings chained through next_in_keyframe
+  // From kernel zero pages (solver/zero_page_allocator.h): a posting is assigned whole when it is
+  // taken, so the array costs resident memory as it is used (or when the owner makes it resident,
+  // queueReservedMemory), not at construction.
+  std::vector<Posting, ZeroPageAllocator<Posting>> postings_;
+  uint32_t free_posting_head_ = kNone;  // returned postings, chained through next_in_keyframe
+  uint32_t fresh_postings_ = 0;         // postings [fresh_postings_, size) were never taken
   std::size_t free_postings_ = 0;
   std::vector<KeyframeSlot> slots_;
   std::vector<uint32_t> free_slots_;  // stack of free slot indices

@@ -62,6 +62,9 @@ LoopCloser::LoopCloser(const CameraIntrinsics& camera, const NoiseModelOptions& 
   for (int s = options.capacity; s >= 0; --s) free_slots_.push_back(s);
   order_.reserve(std::size_t(options.capacity + 1));
   loop_edges_.reserve(std::size_t(options.max_loop_edges));
+  residency_.add(records_.data(), records_.size() * sizeof(LoopCandidate));
+  database_.queueReservedMemory(&residency_);
+  for (const PoseGraph::ReservedRange& range : graph_.reservedRanges()) residency_.add(range.data, range.bytes);
 }
 
 LoopCloser::~LoopCloser() = default;

@@ -21,9 +21,12 @@
 // to its two graph neighbours; not the first, the newest, or one with a loop edge) is culled: its two
 // odometry edges are composed into one (covariances propagated), it leaves the database.
 //
-// MEMORY: everything is allocated in the constructor AND written there, so it is resident from the
-// start and a run's resident set does not grow as the graph fills (memoryBytes(); docs/LOOP.md
-// "Memory"). addKeyframe() makes no operator-new allocation; when a loop is accepted,
+// MEMORY: everything is allocated in the constructor. The large stores (candidate records,
+// database postings, the pose graph's H and factor) are not written there: makeResidentStep()
+// makes them resident a slice at a time (the loop stage calls it after each keyframe but the
+// first), so the first pose does not wait for ~8 MiB of page faults, and after a few keyframes the
+// resident set does not grow as the graph fills (memoryBytes(); docs/LOOP.md "Memory";
+// platform/memory_residency.h). addKeyframe() makes no operator-new allocation; when a loop is accepted,
 // PoseGraph::analyze() (the graph is rebuilt: culling changes its structure) still makes a few
 // malloc calls (Eigen's outer-index arrays).
 #include <chrono>
@@ -129,6 +132,10 @@ class LoopCloser {
   uint32_t idAt(std::size_t i) const { return nodes_[std::size_t(order_[i])].id; }
   std::size_t memoryBytes() const;
   static std::size_t memoryBytesFor(const LoopCloserOptions& options);
+  // Makes up to max_bytes more of the reserved stores resident (contents unchanged). Returns the
+  // bytes still pending; 0 once all are resident.
+  std::size_t makeResidentStep(std::size_t max_bytes) { return residency_.step(max_bytes); }
+  std::size_t residentPendingBytes() const { return residency_.pendingBytes(); }
 
  private:
   struct Node {
@@ -163,9 +170,10 @@ class LoopCloser {
   LoopVerifier verifier_;
   KeyframeDatabase database_;
   PoseGraph graph_;
-  // By slot: what verification needs of each keyframe as a candidate. Value-initialised for the
-  // full capacity at start (resident from then on: memory is the same at frame 1,000 and 10,000).
-  std::vector<LoopCandidate> records_;
+  // By slot: what verification needs of each keyframe as a candidate, for the full capacity. From
+  // kernel zero pages (all-zero bytes = LoopCandidate{}, and makeLoopCandidate assigns a slot
+  // whole): resident as used or as makeResidentStep() reaches it.
+  std::vector<LoopCandidate, ZeroPageAllocator<LoopCandidate>> records_;
   std::vector<Node> nodes_;                  // by slot
   std::vector<int> free_slots_;
   std::vector<int> order_;  // slots by ascending keyframe id
@@ -176,6 +184,7 @@ class LoopCloser {
   bool edges_changed_ = false;  // since the last optimisation
   MapCorrection correction_;
   LoopStats stats_;
+  ResidencyQueue residency_;  // records_, the database's postings, the graph's reserved arrays
 };
 
 }  // namespace plumb::loop

@@ -1,5 +1,6 @@
 #include "pipeline/odometry/map.h"
 
+#include <algorithm>
 #include <type_traits>
 
 #include "solver/zero_page_allocator.h"
@@ -25,13 +26,20 @@ void Map::fillFreeLists() {
 }
 
 void Map::clear() {
+  // Only what was ever handed out: a free keyframe slot already has empty lists (addKeyframe and
+  // removeKeyframe clear them), and landmark slots at or above the high-water mark are in a
+  // cleared state already (zero bytes, or MapPoint{} / MapLine{} from an earlier clear()). Clearing the whole arrays made all of them resident (~2 MiB of
+  // landmarks and pages of every keyframe slot) at the first keyframe, which calls clear().
   for (auto& kf : s_->keyframes) {
+    if (kf.id == 0) continue;
     kf.id = 0;
     kf.points.clear();
     kf.lines.clear();
   }
-  for (auto& p : s_->points) p = MapPoint{};
-  for (auto& l : s_->lines) l = MapLine{};
+  for (uint32_t i = 0; i < points_high_water_; ++i) s_->points[i] = MapPoint{};
+  for (uint32_t i = 0; i < lines_high_water_; ++i) s_->lines[i] = MapLine{};
+  points_high_water_ = 0;
+  lines_high_water_ = 0;
   fillFreeLists();
   // Ids keep growing across clear() (a new map segment): a stale message never matches a new id.
 }
@@ -54,6 +62,7 @@ int Map::addPoint() {
   if (s_->free_points.empty()) return -1;
   const uint32_t slot = s_->free_points.back();
   s_->free_points.pop_back();
+  points_high_water_ = std::max(points_high_water_, slot + 1);
   s_->points[slot] = MapPoint{};
   s_->points[slot].id = next_point_id_++;
   return int(slot);
@@ -63,6 +72,7 @@ int Map::addLine() {
   if (s_->free_lines.empty()) return -1;
   const uint32_t slot = s_->free_lines.back();
   s_->free_lines.pop_back();
+  lines_high_water_ = std::max(lines_high_water_, slot + 1);
   s_->lines[slot] = MapLine{};
   s_->lines[slot].id = next_line_id_++;
   return int(slot);

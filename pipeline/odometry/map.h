@@ -88,6 +88,10 @@ class Map {
   uint32_t next_keyframe_id_ = 1;
   uint32_t next_point_id_ = 1;
   uint32_t next_line_id_ = 1;
+  // One past the highest landmark slot handed out since the last clear(): clear() resets only
+  // those (slots above were never written, see Storage).
+  uint32_t points_high_water_ = 0;
+  uint32_t lines_high_water_ = 0;
   struct StorageDeleter {
     void operator()(Storage* s) const;
   };

@@ -57,7 +57,12 @@ void LoopStage::keyframeInserted(const TrackedFrame& tracked, const FrameOutput&
 }
 
 void LoopStage::process(const loop::LoopKeyframe& record) {
-  if (!closer_->addKeyframe(record)) return;
+  const bool corrected = closer_->addKeyframe(record);
+  // The closer's reserved stores become resident a slice per keyframe from the second keyframe
+  // on: the first is the first frame, whose pose must not wait for ~8 MiB of page faults
+  // (loop_closer.h MEMORY). After ~8 keyframes it is all resident and RSS stays flat.
+  if (keyframes_processed_++ > 0) closer_->makeResidentStep(kResidentBytesPerKeyframe);
+  if (!corrected) return;
   runtime::LatestSnapshot<MapCorrection>& channel = system_.loopCorrections();
   channel.writeBuffer() = closer_->correction();
   channel.publish(++corrections_published_);

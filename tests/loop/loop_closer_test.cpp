@@ -190,3 +190,52 @@ TEST(LoopCloser, AddingKeyframesAllocatesNothing) {
 
 }  // namespace
 }  // namespace plumb::test
+
+namespace plumb::test {
+namespace {
+
+// The reserved stores are not written at construction; makeResidentStep() maps them a slice at a
+// time without changing a byte: a closer stepped to full residency between keyframes closes the
+// same loops with the same poses as one never stepped.
+TEST(LoopCloser, ResidencyStepsChangeNothingAndFinish) {
+  const Scene scene = cylinderScene(21, 6000, 3.5);
+  constexpr int kPerLap = 100, kTotal = 130;
+  auto pose_at = [&](int k) { return outwardPose(2 * M_PI * k / kPerLap, 1.0); };
+  loop::LoopCloserOptions options;
+  loop::LoopCloser stepped = makeCloser(options), plain = makeCloser(options);
+  const std::size_t queued = stepped.residentPendingBytes();
+  // records (129 x ~37.5 KB) + postings + H and factor: most of memoryBytes().
+  EXPECT_GT(queued, stepped.memoryBytes() / 2);
+  EXPECT_LE(queued, stepped.memoryBytes());
+  Eigen::Isometry3d T_odometry = pose_at(0);
+  std::size_t pending = queued;
+  int steps_to_finish = 0;
+  for (int k = 0; k < kTotal; ++k) {
+    Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+    if (k > 0) {
+      step = driftedStep(pose_at(k - 1).inverse() * pose_at(k));
+      T_odometry = T_odometry * step;
+    }
+    const auto record = recordOf(scene, uint32_t(k + 1), pose_at(k), T_odometry, k > 0 ? uint32_t(k) : 0, step);
+    EXPECT_EQ(stepped.addKeyframe(*record), plain.addKeyframe(*record)) << "keyframe " << k;
+    if (pending > 0) {
+      const std::size_t now = stepped.makeResidentStep(std::size_t(1) << 20);
+      EXPECT_EQ(now, pending > (std::size_t(1) << 20) ? pending - (std::size_t(1) << 20) : 0u);
+      pending = now;
+      ++steps_to_finish;
+    }
+  }
+  EXPECT_EQ(stepped.residentPendingBytes(), 0u);
+  EXPECT_EQ(std::size_t(steps_to_finish), (queued + (std::size_t(1) << 20) - 1) >> 20);
+  EXPECT_EQ(plain.residentPendingBytes(), queued);  // nobody stepped it
+  ASSERT_GE(stepped.stats().loops_accepted, 1u);
+  EXPECT_EQ(stepped.stats().loops_accepted, plain.stats().loops_accepted);
+  for (int k = 0; k < kTotal; ++k) {
+    Eigen::Isometry3d a, b;
+    ASSERT_EQ(stepped.pose(uint32_t(k + 1), &a), plain.pose(uint32_t(k + 1), &b));
+    EXPECT_TRUE(a.matrix() == b.matrix()) << "keyframe " << k + 1;
+  }
+}
+
+}  // namespace
+}  // namespace plumb::test
