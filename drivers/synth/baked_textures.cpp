@@ -17,7 +17,8 @@ size_t textureBytes(const TextureRecipe& recipe) { return aligned(static_cast<si
 
 }  // namespace
 
-BakedTextures::BakedTextures(const SceneModel& model) : model_(model), textures_(model.textures.size()) {
+BakedTextures::BakedTextures(const SceneModel& model, uint8_t* canvas_memory, size_t canvas_memory_bytes)
+    : model_(model), textures_(model.textures.size()) {
   size_t canvas_bytes = 0, gain_bytes = 0, texture_bytes = 0;
   for (const TextureRecipe& recipe : model.textures) {
     canvas_bytes = std::max(canvas_bytes, aligned(PaintScratch::canvasBytes(recipe)));
@@ -25,11 +26,14 @@ BakedTextures::BakedTextures(const SceneModel& model) : model_(model), textures_
     texture_bytes += textureBytes(recipe);
     light_scratch_.reserve(recipe.cols);
   }
-  memory_ = HugePageBuffer(canvas_bytes + gain_bytes + texture_bytes);
+  const bool lent_canvas = canvas_memory != nullptr && canvas_bytes > 0 && canvas_bytes <= canvas_memory_bytes;
+  if (lent_canvas) scratch_.canvas = cv::Mat(1, static_cast<int>(canvas_bytes), CV_8U, canvas_memory);
+  const size_t own_canvas_bytes = lent_canvas ? 0 : canvas_bytes;
+  memory_ = HugePageBuffer(own_canvas_bytes + gain_bytes + texture_bytes);
   if (!memory_.data()) return;  // no block: painting allocates as it goes
-  if (canvas_bytes) scratch_.canvas = cv::Mat(1, static_cast<int>(canvas_bytes), CV_8U, memory_.data());
-  if (gain_bytes) scratch_.gain = cv::Mat(1, static_cast<int>(gain_bytes), CV_8U, memory_.data() + canvas_bytes);
-  memory_used_ = canvas_bytes + gain_bytes;
+  if (own_canvas_bytes) scratch_.canvas = cv::Mat(1, static_cast<int>(own_canvas_bytes), CV_8U, memory_.data());
+  if (gain_bytes) scratch_.gain = cv::Mat(1, static_cast<int>(gain_bytes), CV_8U, memory_.data() + own_canvas_bytes);
+  memory_used_ = own_canvas_bytes + gain_bytes;
 }
 
 void BakedTextures::prepare(int quad_index) {

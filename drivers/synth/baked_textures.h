@@ -25,8 +25,11 @@ struct SurfaceTexture {
 class BakedTextures {
  public:
   // Keeps a reference to model (it must outlive this); reserves memory for every texture but
-  // paints nothing yet.
-  explicit BakedTextures(const SceneModel& model);
+  // paints nothing yet. canvas_memory (optional, kept by the caller): memory that painting may
+  // draw in before the blur, used when it holds the largest canvas. The renderer lends its colour
+  // buffer, which is idle while faces are painted (before shading), so the first frame touches
+  // ~3 MB less fresh memory (docs/EMBEDDED.md "First pose").
+  explicit BakedTextures(const SceneModel& model, uint8_t* canvas_memory = nullptr, size_t canvas_memory_bytes = 0);
 
   // Paints and lights quad_index's texture unless that is done already.
   void prepare(int quad_index);

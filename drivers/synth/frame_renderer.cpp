@@ -33,16 +33,25 @@ int clipToNearPlane(const Eigen::Vector3d* in, int count, Eigen::Vector3d* out) 
 
 }  // namespace
 
+namespace {
+size_t pixelsOf(const PinholeCamera& camera) { return static_cast<size_t>(camera.width) * camera.height; }
+}  // namespace
+
+// Colour, depth and quad ids in one huge-page block (few page faults on the first frame). The
+// colour part doubles as the painting canvas: faces are painted after rasterising and before
+// shading (render()), when the colour buffer holds nothing live.
 FrameRenderer::FrameRenderer(const SceneModel& model, const PinholeCamera& camera)
-    : model_(model), camera_(camera), textures_(model) {
+    : model_(model),
+      camera_(camera),
+      buffers_(pixelsOf(camera) * (sizeof(cv::Vec3f) + sizeof(float) + sizeof(int32_t))),
+      textures_(model, buffers_.data(), buffers_.data() ? pixelsOf(camera) * sizeof(cv::Vec3f) : 0) {
   quads_cam_.resize(model.quads.size());
+  won_quads_.reserve(model.quads.size());
   ray_x_.resize(camera.width);
   ray_y_.resize(camera.height);
   for (int x = 0; x < camera.width; ++x) ray_x_[x] = (x - camera.cx) / camera.fx;
   for (int y = 0; y < camera.height; ++y) ray_y_[y] = (y - camera.cy) / camera.fy;
-  // Colour, depth and quad ids in one huge-page block (few page faults on the first frame).
-  const size_t pixels = static_cast<size_t>(camera.width) * camera.height;
-  buffers_ = HugePageBuffer(pixels * (sizeof(cv::Vec3f) + sizeof(float) + sizeof(int32_t)));
+  const size_t pixels = pixelsOf(camera);
   if (buffers_.data()) {
     colour_bgr_ = cv::Mat(camera.height, camera.width, CV_32FC3, buffers_.data());
     depth_m_ = cv::Mat(camera.height, camera.width, CV_32FC1, buffers_.data() + pixels * sizeof(cv::Vec3f));
@@ -63,8 +72,12 @@ void FrameRenderer::render(const Eigen::Isometry3d& T_world_cam) {
   std::fill(quad_id_, quad_id_ + depth_m_.total(), -1);
   // Shading samples only quads whose id is in the z-buffer (pixel centres, and the 3x3
   // neighbourhoods supersampled at edges), all of which won a pixel while rasterising.
+  won_quads_.clear();
   for (int q = 0; q < static_cast<int>(quads_cam_.size()); ++q)
-    if (quads_cam_[q].facing && rasteriseQuad(q)) textures_.prepare(q);
+    if (quads_cam_[q].facing && rasteriseQuad(q)) won_quads_.push_back(q);
+  // Painting draws in the colour buffer (borrowed canvas, see the constructor): all of it before
+  // shading writes colours. A face's texels do not depend on when it is painted.
+  for (int q : won_quads_) textures_.prepare(q);
   shadePixels();
 }
 

@@ -61,10 +61,11 @@ class FrameRenderer {
 
   const SceneModel& model_;
   const PinholeCamera& camera_;
+  HugePageBuffer buffers_;  // colour, depth and quad ids (before textures_, which borrows colour)
   BakedTextures textures_;
   std::vector<QuadInCamera> quads_cam_;
+  std::vector<int> won_quads_;         // quads that won a pixel in the last rasterisation
   std::vector<double> ray_x_, ray_y_;  // (u - cx) / fx per column, (v - cy) / fy per row
-  HugePageBuffer buffers_;             // holds the three below
   int32_t* quad_id_ = nullptr;         // per pixel, -1 = nothing
   cv::Mat colour_bgr_, depth_m_;
   std::vector<int32_t> fallback_quad_id_;  // quad_id_'s memory if buffers_ could not be had
