@@ -12,6 +12,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -19,7 +20,9 @@
 #include "pipeline/frontend/frame_features.h"
 #include "pipeline/odometry/map_capacities.h"
 #include "pipeline/odometry/odometry_options.h"
+#include "platform/memory_residency.h"
 #include "solver/camera_intrinsics.h"
+#include "solver/zero_page_allocator.h"
 
 namespace plumb {
 
@@ -73,7 +76,14 @@ class Relocalizer {
   PinholeCamera camera_;
   CameraIntrinsics intrinsics_;
   OdometryOptions options_;
-  std::unique_ptr<std::array<StoredKeyframe, kMaxRelocKeyframes>> stored_;
+  // The ring of stored keyframes (~1.2 MB), from kernel zero pages (all-zero bytes: empty
+  // feature lists; a slot is claimed before it is read): it is not written at construction, so
+  // the first pose does not wait for it. addKeyframe() makes a slice resident per keyframe from
+  // the second on, so the resident set stops growing after a few keyframes (as with the loop
+  // closer, platform/memory_residency.h).
+  std::vector<StoredKeyframe, ZeroPageAllocator<StoredKeyframe>> stored_;
+  ResidencyQueue residency_;
+  std::size_t keyframes_added_ = 0;
   std::size_t count_ = 0;
   std::size_t next_ = 0;  // ring position of the next insertion
   // Matching / RANSAC / pose scratch (~250 KB), from zero pages: written before it is read (the
