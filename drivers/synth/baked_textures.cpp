@@ -36,18 +36,51 @@ BakedTextures::BakedTextures(const SceneModel& model, uint8_t* canvas_memory, si
   memory_used_ = own_canvas_bytes + gain_bytes;
 }
 
-void BakedTextures::prepare(int quad_index) {
+void BakedTextures::paint(int quad_index) {
   const SceneQuad& quad = model_.quads[quad_index];
   SurfaceTexture& texture = textures_[quad.texture];
-  if (!texture.bgr.empty()) return;
   const TextureRecipe& recipe = model_.textures[quad.texture];
   if (memory_.data()) {
     texture.bgr = cv::Mat(recipe.rows, recipe.cols, CV_8UC3, memory_.data() + memory_used_);
     memory_used_ += textureBytes(recipe);
   }
   paintTexture(recipe, scratch_, texture.bgr);
-  bakeLighting(model_, quad, recipe.texels_per_metre, texture.bgr, light_scratch_);
   texture.texels_per_metre = recipe.texels_per_metre;
+}
+
+void BakedTextures::light(int quad_index) {
+  const SceneQuad& quad = model_.quads[quad_index];
+  SurfaceTexture& texture = textures_[quad.texture];
+  bakeLighting(model_, quad, model_.textures[quad.texture].texels_per_metre, texture.bgr, light_scratch_);
+}
+
+void BakedTextures::prepare(int quad_index) {
+  if (painted(quad_index)) return;
+  paint(quad_index);
+  light(quad_index);
+}
+
+void BakedTextures::prepareAll(const int* quads, int count, runtime::HelperThread* helper) {
+  // Below this many texels in the pair, handing the lighting over costs more than it saves.
+  constexpr long kMinTexelsToOverlap = 64 * 1024;
+  auto texels = [&](int q) {
+    const TextureRecipe& r = model_.textures[model_.quads[q].texture];
+    return long(r.rows) * r.cols;
+  };
+  int to_light = -1;  // painted, not yet lit
+  for (int i = 0; i < count; ++i) {
+    const int q = quads[i];
+    if (painted(q)) continue;
+    if (to_light >= 0 && helper != nullptr && texels(to_light) + texels(q) >= kMinTexelsToOverlap) {
+      const int lit = to_light;
+      helper->runBoth([&] { paint(q); }, [&] { light(lit); });
+    } else {
+      if (to_light >= 0) light(to_light);
+      paint(q);
+    }
+    to_light = q;
+  }
+  if (to_light >= 0) light(to_light);
 }
 
 }  // namespace plumb::synth

@@ -12,6 +12,7 @@
 
 #include "drivers/synth/light_baking.h"
 #include "drivers/synth/scene_model.h"
+#include "runtime/helper_thread.h"
 #include "platform/huge_page_buffer.h"
 
 namespace plumb::synth {
@@ -33,10 +34,17 @@ class BakedTextures {
 
   // Paints and lights quad_index's texture unless that is done already.
   void prepare(int quad_index);
+  // prepare() for each of quads[0..count). With a helper, one face is lit on it while the next is
+  // painted here (lighting touches only its own face's texels; painting uses the scratch): the
+  // same texels as prepare() one by one.
+  void prepareAll(const int* quads, int count, runtime::HelperThread* helper);
   // The texture of a prepared quad.
   const SurfaceTexture& texture(int quad_index) const { return textures_[model_.quads[quad_index].texture]; }
 
  private:
+  bool painted(int quad_index) const { return !texture(quad_index).bgr.empty(); }
+  void paint(int quad_index);  // the caller's thread only: hands out memory, uses the scratch
+  void light(int quad_index);  // one thread at a time: uses light_scratch_
   const SceneModel& model_;
   std::vector<SurfaceTexture> textures_;  // indexed like model.textures
   // One block for every texture and the painting scratch, sized at construction: textures are

@@ -77,7 +77,7 @@ void FrameRenderer::render(const Eigen::Isometry3d& T_world_cam) {
     if (quads_cam_[q].facing && rasteriseQuad(q)) won_quads_.push_back(q);
   // Painting draws in the colour buffer (borrowed canvas, see the constructor): all of it before
   // shading writes colours. A face's texels do not depend on when it is painted.
-  for (int q : won_quads_) textures_.prepare(q);
+  textures_.prepareAll(won_quads_.data(), static_cast<int>(won_quads_.size()), helper_.get());
   shadePixels();
 }
 
@@ -198,9 +198,18 @@ inline cv::Vec3f FrameRenderer::shadePoint(int quad_index, const Eigen::Vector3d
 }
 
 void FrameRenderer::shadePixels() {
+  // Every pixel reads only the z-buffer, the quads and the textures, and writes its own colour:
+  // the lower half of the rows on the helper thread, the upper half here.
+  const int middle = camera_.height / 2;
+  int upper = 0, lower = 0;
+  helper_->runBoth([&] { upper = shadeRows(0, middle); }, [&] { lower = shadeRows(middle, camera_.height); });
+  edge_pixels_ = upper + lower;
+}
+
+int FrameRenderer::shadeRows(int row_begin, int row_end) {
   const int width = camera_.width, height = camera_.height;
-  edge_pixels_ = 0;
-  for (int y = 0; y < height; ++y) {
+  int edge_pixels = 0;
+  for (int y = row_begin; y < row_end; ++y) {
     const float* depth_row = depth_m_.ptr<float>(y);
     const int32_t* id_row = quad_id_ + static_cast<size_t>(y) * width;
     cv::Vec3f* colour_row = colour_bgr_.ptr<cv::Vec3f>(y);
@@ -219,7 +228,7 @@ void FrameRenderer::shadePixels() {
         colour_row[x] = centre;
         continue;
       }
-      ++edge_pixels_;
+      ++edge_pixels;
       // Candidate quads: the distinct ids of the 3x3 neighbourhood.
       int candidates[9], count = 0;
       for (int dy = -1; dy <= 1; ++dy) {
@@ -247,6 +256,7 @@ void FrameRenderer::shadePixels() {
       colour_row[x] = sum * (1.0f / 9.0f);
     }
   }
+  return edge_pixels;
 }
 
 }  // namespace plumb::synth

@@ -16,6 +16,7 @@
 // Shading is view-independent (Lambert), so a surface point has the same colour in every frame.
 // Every quad must have a texture recipe (planLightMaps gives flat faces a light map).
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -54,6 +55,8 @@ class FrameRenderer {
   // Returns whether the quad won at least one pixel (so far: a later quad may cover it again).
   bool rasteriseQuad(int quad_index);
   void shadePixels();
+  // Rows [row_begin, row_end) of shadePixels(); returns the pixels supersampled.
+  int shadeRows(int row_begin, int row_end);
   // Nearest quad among `candidates` hit by the ray through (u, v); -1 if none. Sets *z.
   int castRay(double u, double v, const int* candidates, int count, double* z) const;
   cv::Vec3f shadePoint(int quad_index, const Eigen::Vector3d& P_cam) const;
@@ -70,6 +73,9 @@ class FrameRenderer {
   cv::Mat colour_bgr_, depth_m_;
   std::vector<int32_t> fallback_quad_id_;  // quad_id_'s memory if buffers_ could not be had
   int edge_pixels_ = 0;
+  // Paints the next face while lighting the last, and shades half the rows (runtime/helper_thread.h).
+  // Held by pointer: the renderer stays movable.
+  std::unique_ptr<runtime::HelperThread> helper_ = std::make_unique<runtime::HelperThread>();
 };
 
 }  // namespace plumb::synth

@@ -3,17 +3,21 @@
 // were rendered before it (the order in which faces got painted).
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <memory>
+#include <numeric>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
+#include "drivers/synth/baked_textures.h"
 #include "drivers/synth/corridor_layout.h"
 #include "drivers/synth/light_baking.h"
 #include "drivers/synth/room_layout.h"
 #include "drivers/synth/synth_random.h"
 #include "drivers/synth/synthetic_scene.h"
 #include "drivers/synth/texel_gain.h"
+#include "runtime/helper_thread.h"
 
 namespace plumb {
 namespace {
@@ -95,6 +99,28 @@ TEST(SynthTextures, SimdTexelMultiplyEqualsSaturateCast) {
       for (int k = 0; k < 3; ++k) expected[i][k] = cv::saturate_cast<uchar>(texels[i][k] * gain[i]);
     synth::multiplyTexels(texels.data(), gain.data(), count);
     for (int i = 0; i < count; ++i) ASSERT_EQ(texels[i], expected[i]) << "texel " << i << " gain " << gain[i];
+  }
+}
+
+// The renderer paints a frame's faces with prepareAll (face i lit on a helper thread while face
+// i + 1 is painted) into a canvas it lends (its colour buffer): the texels of prepare(), face by
+// face, on one thread with the textures' own canvas.
+TEST(SynthTextures, PaintingWithAHelperThreadAndALentCanvasGivesTheSameTexels) {
+  for (const synth::SceneModel& model :
+       {synth::buildRoom(synth::RoomLayoutOptions{}), synth::buildCorridor(synth::CorridorLayoutOptions{})}) {
+    std::vector<int> quads(model.quads.size());
+    std::iota(quads.begin(), quads.end(), 0);
+    synth::BakedTextures one_by_one(model);
+    for (int q : quads) one_by_one.prepare(q);
+    std::vector<uint8_t> lent(std::size_t(16) << 20);
+    synth::BakedTextures overlapped(model, lent.data(), lent.size());
+    runtime::HelperThread helper;
+    overlapped.prepareAll(quads.data(), static_cast<int>(quads.size()), &helper);
+    for (int q : quads) ASSERT_TRUE(sameBytes(one_by_one.texture(q).bgr, overlapped.texture(q).bgr)) << "quad " << q;
+    // Some pairs of faces are large enough to be overlapped (>= 64k texels), or this tests nothing.
+    int large = 0;
+    for (const synth::TextureRecipe& r : model.textures) large += long(r.rows) * r.cols >= 32 * 1024;
+    EXPECT_GE(large, 2);
   }
 }
 
