@@ -34,6 +34,22 @@ void touchPages(char* data, std::size_t bytes) {
 
 }  // namespace
 
+bool populateForWrite(void* data, std::size_t bytes) {
+#if defined(__linux__)
+  if (data == nullptr || bytes == 0) return true;
+  const std::size_t page = pageBytes();
+  const std::uintptr_t begin = reinterpret_cast<std::uintptr_t>(data);
+  const std::uintptr_t first = (begin + page - 1) & ~(std::uintptr_t(page) - 1);
+  const std::uintptr_t last = (begin + bytes) & ~(std::uintptr_t(page) - 1);
+  if (last <= first) return true;
+  return madvise(reinterpret_cast<void*>(first), last - first, MADV_POPULATE_WRITE) == 0;
+#else
+  (void)data;
+  (void)bytes;
+  return false;
+#endif
+}
+
 void makeResident(void* data, std::size_t bytes) {
   if (data == nullptr || bytes == 0) return;
   char* const begin = static_cast<char*>(data);

@@ -19,6 +19,10 @@ namespace plumb {
 
 // Pages of [data, data + bytes) resident and writable; contents unchanged.
 void makeResident(void* data, std::size_t bytes);
+// The same through the kernel only (MADV_POPULATE_WRITE on the whole pages inside the range):
+// never reads or writes a byte, so another thread may be using the memory meanwhile. False where
+// the kernel cannot (before Linux 5.14, other systems): nothing was done.
+bool populateForWrite(void* data, std::size_t bytes);
 
 class ResidencyQueue {
  public:

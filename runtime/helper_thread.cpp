@@ -6,6 +6,7 @@ namespace plumb::runtime {
 
 HelperThread::~HelperThread() {
   if (!thread_.joinable()) return;
+  waitDone();
   stop_.store(true, std::memory_order_release);
   posted_bell_.ring();
   thread_.join();

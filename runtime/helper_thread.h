@@ -29,6 +29,7 @@ class HelperThread {
 
   template <class Here, class There>
   void runBoth(Here&& here, There&& there) {
+    waitDone();  // a job from startJob()
     if (!started()) {  // no thread to be had: both parts here, one after the other
       here();
       there();
@@ -37,6 +38,15 @@ class HelperThread {
     post(&call<std::remove_reference_t<There>>, &there);
     here();
     waitDone();
+  }
+
+  // Starts job(context) on the helper and returns at once; the next runBoth() (or destruction)
+  // waits for it. context must stay valid until then. False (nothing run) if no thread can be had.
+  bool startJob(void (*job)(void*), void* context) {
+    waitDone();
+    if (!started()) return false;
+    post(job, context);
+    return true;
   }
 
  private:

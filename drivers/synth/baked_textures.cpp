@@ -33,7 +33,7 @@ BakedTextures::BakedTextures(const SceneModel& model, uint8_t* canvas_memory, si
   if (!memory_.data()) return;  // no block: painting allocates as it goes
   if (own_canvas_bytes) scratch_.canvas = cv::Mat(1, static_cast<int>(own_canvas_bytes), CV_8U, memory_.data());
   if (gain_bytes) scratch_.gain = cv::Mat(1, static_cast<int>(gain_bytes), CV_8U, memory_.data() + own_canvas_bytes);
-  memory_used_ = own_canvas_bytes + gain_bytes;
+  memory_used_ = scratch_bytes_ = own_canvas_bytes + gain_bytes;
 }
 
 void BakedTextures::paint(int quad_index) {

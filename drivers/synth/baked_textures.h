@@ -40,6 +40,10 @@ class BakedTextures {
   void prepareAll(const int* quads, int count, runtime::HelperThread* helper);
   // The texture of a prepared quad.
   const SurfaceTexture& texture(int quad_index) const { return textures_[model_.quads[quad_index].texture]; }
+  // The painting scratch in this object's block (the gain buffer, and the canvas unless lent):
+  // every frame that paints a procedural face writes it.
+  uint8_t* scratchData() const { return memory_.data(); }
+  size_t scratchBytes() const { return memory_.data() ? scratch_bytes_ : 0; }
 
  private:
   bool painted(int quad_index) const { return !texture(quad_index).bgr.empty(); }
@@ -51,6 +55,7 @@ class BakedTextures {
   // handed out from it as they are painted (huge pages: few page faults; see huge_page_buffer.h).
   HugePageBuffer memory_;
   size_t memory_used_ = 0;
+  size_t scratch_bytes_ = 0;  // at the start of memory_
   PaintScratch scratch_;
   LightScratch light_scratch_;
 };

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "platform/memory_residency.h"
+
 namespace plumb::synth {
 namespace {
 
@@ -52,6 +54,10 @@ FrameRenderer::FrameRenderer(const SceneModel& model, const PinholeCamera& camer
   for (int x = 0; x < camera.width; ++x) ray_x_[x] = (x - camera.cx) / camera.fx;
   for (int y = 0; y < camera.height; ++y) ray_y_[y] = (y - camera.cy) / camera.fy;
   const size_t pixels = pixelsOf(camera);
+  // The render buffers and the painting scratch are written by every first frame. The helper
+  // thread maps them now (the kernel only, no byte touched), while the caller goes on to build
+  // whatever reads the frames; render() waits for it before its first use of the helper.
+  helper_->startJob(&populateBuffers, this);
   if (buffers_.data()) {
     colour_bgr_ = cv::Mat(camera.height, camera.width, CV_32FC3, buffers_.data());
     depth_m_ = cv::Mat(camera.height, camera.width, CV_32FC1, buffers_.data() + pixels * sizeof(cv::Vec3f));
@@ -62,6 +68,12 @@ FrameRenderer::FrameRenderer(const SceneModel& model, const PinholeCamera& camer
     fallback_quad_id_.resize(pixels);
     quad_id_ = fallback_quad_id_.data();
   }
+}
+
+void FrameRenderer::populateBuffers(void* renderer) {
+  FrameRenderer& r = *static_cast<FrameRenderer*>(renderer);
+  (void)populateForWrite(r.buffers_.data(), r.buffers_.size());
+  (void)populateForWrite(r.textures_.scratchData(), r.textures_.scratchBytes());
 }
 
 void FrameRenderer::render(const Eigen::Isometry3d& T_world_cam) {
@@ -198,12 +210,19 @@ inline cv::Vec3f FrameRenderer::shadePoint(int quad_index, const Eigen::Vector3d
 }
 
 void FrameRenderer::shadePixels() {
-  // Every pixel reads only the z-buffer, the quads and the textures, and writes its own colour:
-  // the lower half of the rows on the helper thread, the upper half here.
-  const int middle = camera_.height / 2;
-  int upper = 0, lower = 0;
-  helper_->runBoth([&] { upper = shadeRows(0, middle); }, [&] { lower = shadeRows(middle, camera_.height); });
-  edge_pixels_ = upper + lower;
+  // Every pixel reads only the z-buffer, the quads and the textures, and writes its own colour.
+  // Bands of rows alternate between this thread and the helper (halves would not balance: the
+  // floor in the lower half is costlier to sample than the walls above).
+  constexpr int kBandRows = 16;
+  auto shadeBands = [this](int first_band) {
+    int edges = 0;
+    for (int y = first_band * kBandRows; y < camera_.height; y += 2 * kBandRows)
+      edges += shadeRows(y, std::min(y + kBandRows, camera_.height));
+    return edges;
+  };
+  int here = 0, there = 0;
+  helper_->runBoth([&] { here = shadeBands(0); }, [&] { there = shadeBands(1); });
+  edge_pixels_ = here + there;
 }
 
 int FrameRenderer::shadeRows(int row_begin, int row_end) {

@@ -34,6 +34,9 @@ class FrameRenderer {
   // Keeps references to model and camera (both must outlive the renderer); allocates all buffers
   // but the textures, which are painted as frames first show their faces.
   FrameRenderer(const SceneModel& model, const PinholeCamera& camera);
+  // Not movable: the helper thread's first job (populateBuffers) holds `this`.
+  FrameRenderer(const FrameRenderer&) = delete;
+  FrameRenderer& operator=(const FrameRenderer&) = delete;
 
   void render(const Eigen::Isometry3d& T_world_cam);
 
@@ -51,6 +54,8 @@ class FrameRenderer {
     bool facing = false;
   };
 
+  // Helper-thread job started by the constructor: maps buffers_ and the painting scratch.
+  static void populateBuffers(void* renderer);
   void transformQuads(const Eigen::Isometry3d& T_world_cam);
   // Returns whether the quad won at least one pixel (so far: a later quad may cover it again).
   bool rasteriseQuad(int quad_index);
@@ -74,7 +79,7 @@ class FrameRenderer {
   std::vector<int32_t> fallback_quad_id_;  // quad_id_'s memory if buffers_ could not be had
   int edge_pixels_ = 0;
   // Paints the next face while lighting the last, and shades half the rows (runtime/helper_thread.h).
-  // Held by pointer: the renderer stays movable.
+  // Last member: destroyed first, so it finishes any job before the buffers go.
   std::unique_ptr<runtime::HelperThread> helper_ = std::make_unique<runtime::HelperThread>();
 };
 

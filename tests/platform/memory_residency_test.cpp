@@ -55,6 +55,20 @@ TEST(MemoryResidency, MakeResidentMapsEveryPageAndKeepsTheBytes) {
   }
 }
 
+TEST(MemoryResidency, PopulateForWriteMapsWholePagesWithoutTouchingAByte) {
+  const std::size_t page = std::size_t(sysconf(_SC_PAGESIZE));
+  Mapping m(16 * page);
+  ASSERT_NE(m.data(), MAP_FAILED);
+  m.data()[2 * page + 5] = 9;
+  // From inside page 1 to inside page 9: whole pages 2..8 are populated; the partial pages at the
+  // ends are left alone (it never touches a byte by hand).
+  if (!populateForWrite(m.data() + page + 10, 8 * page)) GTEST_SKIP() << "no MADV_POPULATE_WRITE (Linux < 5.14)";
+  EXPECT_EQ(m.residentPages(2 * page, 7 * page), 7u);
+  EXPECT_EQ(m.residentPages(page, page), 0u);
+  EXPECT_EQ(m.residentPages(9 * page, 7 * page), 0u);
+  EXPECT_EQ(m.data()[2 * page + 5], 9);
+}
+
 TEST(MemoryResidency, QueueStepsThroughRangesInOrder) {
   const std::size_t page = std::size_t(sysconf(_SC_PAGESIZE));
   Mapping m(32 * page);

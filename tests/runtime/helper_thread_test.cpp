@@ -49,6 +49,21 @@ TEST(HelperThread, HalvesOfARowLoopGiveTheOneThreadResult) {
   EXPECT_EQ(one, two);
 }
 
+TEST(HelperThread, AStartedJobFinishesBeforeTheNextRunBoth) {
+  HelperThread helper;
+  struct Job {
+    std::vector<int> out = std::vector<int>(100000, 0);
+    static void run(void* self) {
+      for (int& v : static_cast<Job*>(self)->out) v = 7;
+    }
+  } job;
+  ASSERT_TRUE(helper.startJob(&Job::run, &job));
+  int sum_seen_by_there = 0;
+  helper.runBoth([] {}, [&] { sum_seen_by_there = job.out.front() + job.out.back(); });
+  EXPECT_EQ(sum_seen_by_there, 14);  // the job was done before runBoth's part began
+  for (int v : job.out) ASSERT_EQ(v, 7);
+}
+
 TEST(HelperThread, DestructionWithoutUseAndAfterUseReturns) {
   { HelperThread unused; }
   {
