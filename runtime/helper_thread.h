@@ -40,6 +40,9 @@ class HelperThread {
     waitDone();
   }
 
+  // Returns when the helper is idle (a job from startJob() done).
+  void wait() { waitDone(); }
+
   // Starts job(context) on the helper and returns at once; the next runBoth() (or destruction)
   // waits for it. context must stay valid until then. False (nothing run) if no thread can be had.
   bool startJob(void (*job)(void*), void* context) {

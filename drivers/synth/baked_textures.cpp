@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "drivers/synth/light_baking.h"
+#include "platform/memory_residency.h"
 
 namespace plumb::synth {
 
@@ -14,6 +15,9 @@ constexpr size_t kAlignment = 64;  // each texture starts on a cache line
 size_t aligned(size_t bytes) { return (bytes + kAlignment - 1) & ~(kAlignment - 1); }
 
 size_t textureBytes(const TextureRecipe& recipe) { return aligned(static_cast<size_t>(recipe.rows) * recipe.cols * 3); }
+
+// Below this, mapping the new faces' memory ahead is not worth a hand-over.
+constexpr size_t kMinBytesToPopulate = size_t(256) << 10;
 
 }  // namespace
 
@@ -34,6 +38,11 @@ BakedTextures::BakedTextures(const SceneModel& model, uint8_t* canvas_memory, si
   if (own_canvas_bytes) scratch_.canvas = cv::Mat(1, static_cast<int>(own_canvas_bytes), CV_8U, memory_.data());
   if (gain_bytes) scratch_.gain = cv::Mat(1, static_cast<int>(gain_bytes), CV_8U, memory_.data() + own_canvas_bytes);
   memory_used_ = scratch_bytes_ = own_canvas_bytes + gain_bytes;
+}
+
+void BakedTextures::PopulateJob::run(void* job) {
+  const PopulateJob& j = *static_cast<const PopulateJob*>(job);
+  (void)populateForWrite(j.data, j.bytes);
 }
 
 void BakedTextures::paint(int quad_index) {
@@ -67,6 +76,21 @@ void BakedTextures::prepareAll(const int* quads, int count, runtime::HelperThrea
     const TextureRecipe& r = model_.textures[model_.quads[q].texture];
     return long(r.rows) * r.cols;
   };
+  // The memory the new faces' texels will take (handed out in painting order, so one range):
+  // the helper maps it while the first face is painted (the kernel only, no byte touched), and
+  // the painting that follows does not stop for page faults.
+  if (helper != nullptr && memory_.data()) {
+    size_t need = 0;
+    for (int i = 0; i < count; ++i) {
+      if (!painted(quads[i])) need += textureBytes(model_.textures[model_.quads[quads[i]].texture]);
+    }
+    need = std::min(need, memory_.size() - memory_used_);
+    if (need >= kMinBytesToPopulate) {
+      helper->wait();  // populate_ may still be read by an earlier job
+      populate_ = PopulateJob{memory_.data() + memory_used_, need};
+      (void)helper->startJob(&PopulateJob::run, &populate_);
+    }
+  }
   int to_light = -1;  // painted, not yet lit
   for (int i = 0; i < count; ++i) {
     const int q = quads[i];
@@ -81,6 +105,7 @@ void BakedTextures::prepareAll(const int* quads, int count, runtime::HelperThrea
     to_light = q;
   }
   if (to_light >= 0) light(to_light);
+  if (helper != nullptr) helper->wait();  // the populate job, if no hand-over waited for it
 }
 
 }  // namespace plumb::synth

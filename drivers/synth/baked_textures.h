@@ -56,6 +56,13 @@ class BakedTextures {
   HugePageBuffer memory_;
   size_t memory_used_ = 0;
   size_t scratch_bytes_ = 0;  // at the start of memory_
+  // prepareAll's helper job: map the memory the next faces will take.
+  struct PopulateJob {
+    uint8_t* data = nullptr;
+    size_t bytes = 0;
+    static void run(void* job);
+  };
+  PopulateJob populate_;
   PaintScratch scratch_;
   LightScratch light_scratch_;
 };
