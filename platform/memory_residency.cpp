@@ -32,20 +32,24 @@ void touchPages(char* data, std::size_t bytes) {
   if (bytes > 0) p[bytes - 1] = p[bytes - 1];
 }
 
+// The whole pages inside [data, data + bytes): [*first, *last) (empty when last <= first).
+void wholePages(void* data, std::size_t bytes, std::uintptr_t* first, std::uintptr_t* last) {
+  const std::size_t page = pageBytes();
+  const std::uintptr_t begin = reinterpret_cast<std::uintptr_t>(data);
+  *first = (begin + page - 1) & ~(std::uintptr_t(page) - 1);
+  *last = (begin + bytes) & ~(std::uintptr_t(page) - 1);
+}
+
 }  // namespace
 
 bool populateForWrite(void* data, std::size_t bytes) {
-#if defined(__linux__)
   if (data == nullptr || bytes == 0) return true;
-  const std::size_t page = pageBytes();
-  const std::uintptr_t begin = reinterpret_cast<std::uintptr_t>(data);
-  const std::uintptr_t first = (begin + page - 1) & ~(std::uintptr_t(page) - 1);
-  const std::uintptr_t last = (begin + bytes) & ~(std::uintptr_t(page) - 1);
+#if defined(__linux__)
+  std::uintptr_t first = 0, last = 0;
+  wholePages(data, bytes, &first, &last);
   if (last <= first) return true;
   return madvise(reinterpret_cast<void*>(first), last - first, MADV_POPULATE_WRITE) == 0;
 #else
-  (void)data;
-  (void)bytes;
   return false;
 #endif
 }
@@ -53,18 +57,15 @@ bool populateForWrite(void* data, std::size_t bytes) {
 void makeResident(void* data, std::size_t bytes) {
   if (data == nullptr || bytes == 0) return;
   char* const begin = static_cast<char*>(data);
-#if defined(__linux__)
-  // madvise wants a page-aligned start: the partial pages at either end are touched by hand.
-  const std::size_t page = pageBytes();
-  const std::uintptr_t first = (reinterpret_cast<std::uintptr_t>(begin) + page - 1) & ~(std::uintptr_t(page) - 1);
-  const std::uintptr_t last = (reinterpret_cast<std::uintptr_t>(begin) + bytes) & ~(std::uintptr_t(page) - 1);
-  if (last > first && madvise(reinterpret_cast<void*>(first), last - first, MADV_POPULATE_WRITE) == 0) {
-    touchPages(begin, std::min<std::size_t>(bytes, first - reinterpret_cast<std::uintptr_t>(begin)));
-    const std::size_t tail = reinterpret_cast<std::uintptr_t>(begin) + bytes - last;
-    touchPages(reinterpret_cast<char*>(last), tail);
+  std::uintptr_t first = 0, last = 0;
+  wholePages(data, bytes, &first, &last);
+  // The kernel maps the whole pages; the partial pages at either end are touched by hand.
+  if (last > first && populateForWrite(data, bytes)) {
+    const std::uintptr_t start = reinterpret_cast<std::uintptr_t>(begin);
+    touchPages(begin, first - start);
+    touchPages(reinterpret_cast<char*>(last), start + bytes - last);
     return;
   }
-#endif
   touchPages(begin, bytes);
 }
 
