@@ -45,6 +45,9 @@ class FrameRenderer {
   const cv::Mat& colour() const { return colour_bgr_; }  // CV_32FC3
   const cv::Mat& depth() const { return depth_m_; }       // CV_32FC1
   int edgePixelCount() const { return edge_pixels_; }     // pixels supersampled in the last render
+  // The renderer's second thread, for the caller's own two-part work on the same thread (the
+  // scene quantises colour and depth on it); not while render() runs.
+  runtime::HelperThread& helper() { return *helper_; }
 
  private:
   // A quad moved into the camera frame for the current pose.
