@@ -34,37 +34,35 @@ class BakedTextures {
 
   // Paints and lights quad_index's texture unless that is done already.
   void prepare(int quad_index);
-  // prepare() for each of quads[0..count). With a helper, one face is lit on it while the next is
-  // painted here (lighting touches only its own face's texels; painting uses the scratch): the
-  // same texels as prepare() one by one.
-  void prepareAll(const int* quads, int count, runtime::HelperThread* helper);
+  // prepare() for each of quads[0..count). With a helper, the faces are shared between it and
+  // the caller (each paints and lights its own, with its own scratch; memory is handed out in
+  // list order first): the same texels as prepare() one by one.
+  // Returns the number of faces it painted.
+  int prepareAll(const int* quads, int count, runtime::HelperThread* helper);
   // The texture of a prepared quad.
   const SurfaceTexture& texture(int quad_index) const { return textures_[model_.quads[quad_index].texture]; }
-  // The painting scratch in this object's block (the gain buffer, and the canvas unless lent):
-  // every frame that paints a procedural face writes it.
+  // The painting scratch in this object's block (both painters' gain buffers and canvases but a
+  // lent one): a frame that paints procedural faces writes it.
   uint8_t* scratchData() const { return memory_.data(); }
   size_t scratchBytes() const { return memory_.data() ? scratch_bytes_ : 0; }
 
  private:
-  bool painted(int quad_index) const { return !texture(quad_index).bgr.empty(); }
-  void paint(int quad_index);  // the caller's thread only: hands out memory, uses the scratch
-  void light(int quad_index);  // one thread at a time: uses light_scratch_
+  bool painted(int quad_index) const { return taken_[model_.quads[quad_index].texture] != 0; }
+  // Hands out the face's texture memory (list order: the same layout however it is painted).
+  void take(int quad_index);
+  // Paints and lights a taken face with painter k's scratch (k = 0: the caller, 1: the helper).
+  void paintAndLight(int quad_index, int k);
   const SceneModel& model_;
   std::vector<SurfaceTexture> textures_;  // indexed like model.textures
+  std::vector<uint8_t> taken_;            // indexed like model.textures: memory handed out
   // One block for every texture and the painting scratch, sized at construction: textures are
   // handed out from it as they are painted (huge pages: few page faults; see huge_page_buffer.h).
   HugePageBuffer memory_;
   size_t memory_used_ = 0;
   size_t scratch_bytes_ = 0;  // at the start of memory_
-  // prepareAll's helper job: map the memory the next faces will take.
-  struct PopulateJob {
-    uint8_t* data = nullptr;
-    size_t bytes = 0;
-    static void run(void* job);
-  };
-  PopulateJob populate_;
-  PaintScratch scratch_;
-  LightScratch light_scratch_;
+  PaintScratch scratch_[2];
+  LightScratch light_scratch_[2];
+  std::vector<int> share_[2];  // prepareAll: the faces each painter does
 };
 
 }  // namespace plumb::synth

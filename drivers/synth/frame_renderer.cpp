@@ -89,8 +89,11 @@ void FrameRenderer::render(const Eigen::Isometry3d& T_world_cam) {
     if (quads_cam_[q].facing && rasteriseQuad(q)) won_quads_.push_back(q);
   // Painting draws in the colour buffer (borrowed canvas, see the constructor): all of it before
   // shading writes colours. A face's texels do not depend on when it is painted.
-  textures_.prepareAll(won_quads_.data(), static_cast<int>(won_quads_.size()), helper_.get());
-  shadePixels();
+  // The helper thread works only on frames that paint faces (the first frame, and first sightings
+  // later): a steady run's frames render on the caller alone, as they did before it existed, so
+  // a real-time pipeline fed by this scene keeps the other core.
+  painted_faces_ = textures_.prepareAll(won_quads_.data(), static_cast<int>(won_quads_.size()), helper_.get()) > 0;
+  shadePixels(painted_faces_);
 }
 
 void FrameRenderer::transformQuads(const Eigen::Isometry3d& T_world_cam) {
@@ -209,7 +212,11 @@ inline cv::Vec3f FrameRenderer::shadePoint(int quad_index, const Eigen::Vector3d
   return sampleTexture(textures_.texture(quad_index), offset.dot(qc.axis_u), offset.dot(qc.axis_v));
 }
 
-void FrameRenderer::shadePixels() {
+void FrameRenderer::shadePixels(bool two_threads) {
+  if (!two_threads) {
+    edge_pixels_ = shadeRows(0, camera_.height);
+    return;
+  }
   // Every pixel reads only the z-buffer, the quads and the textures, and writes its own colour.
   // Bands of rows alternate between this thread and the helper (halves would not balance: the
   // floor in the lower half is costlier to sample than the walls above).

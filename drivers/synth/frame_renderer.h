@@ -45,6 +45,8 @@ class FrameRenderer {
   const cv::Mat& colour() const { return colour_bgr_; }  // CV_32FC3
   const cv::Mat& depth() const { return depth_m_; }       // CV_32FC1
   int edgePixelCount() const { return edge_pixels_; }     // pixels supersampled in the last render
+  // Whether the last render painted faces (and so used the helper thread).
+  bool paintedFaces() const { return painted_faces_; }
   // The renderer's second thread, for the caller's own two-part work on the same thread (the
   // scene quantises colour and depth on it); not while render() runs.
   runtime::HelperThread& helper() { return *helper_; }
@@ -62,7 +64,7 @@ class FrameRenderer {
   void transformQuads(const Eigen::Isometry3d& T_world_cam);
   // Returns whether the quad won at least one pixel (so far: a later quad may cover it again).
   bool rasteriseQuad(int quad_index);
-  void shadePixels();
+  void shadePixels(bool two_threads);
   // Rows [row_begin, row_end) of shadePixels(); returns the pixels supersampled.
   int shadeRows(int row_begin, int row_end);
   // Nearest quad among `candidates` hit by the ray through (u, v); -1 if none. Sets *z.
@@ -81,6 +83,7 @@ class FrameRenderer {
   cv::Mat colour_bgr_, depth_m_;
   std::vector<int32_t> fallback_quad_id_;  // quad_id_'s memory if buffers_ could not be had
   int edge_pixels_ = 0;
+  bool painted_faces_ = false;
   // Paints the next face while lighting the last, and shades half the rows (runtime/helper_thread.h).
   // Last member: destroyed first, so it finishes any job before the buffers go.
   std::unique_ptr<runtime::HelperThread> helper_ = std::make_unique<runtime::HelperThread>();

@@ -166,11 +166,16 @@ Status SyntheticScene::render(int i, RgbdImage& out) const {
   if (i < 0) return Status::Error("synth: frame index must be >= 0 (got " + std::to_string(i) + ")");
   SyntheticSceneImpl& impl = *impl_;
   impl.renderer_.render(T_world_cam(i));
-  // Colour and depth are quantised independently (separate noise streams, separate outputs):
-  // one on the renderer's helper thread, one here.
-  impl.renderer_.helper().runBoth(
-      [&] { synth::quantiseColour(impl.renderer_.colour(), impl.sensor_, impl.noise_seed_, i, out.bgr); },
-      [&] { synth::quantiseDepth(impl.renderer_.depth(), impl.sensor_, impl.noise_seed_, i, out.depth_raw); });
+  // Colour and depth are quantised independently (separate noise streams, separate outputs): on
+  // a frame that painted faces (the renderer used its helper thread), one there, one here.
+  auto colour = [&] { synth::quantiseColour(impl.renderer_.colour(), impl.sensor_, impl.noise_seed_, i, out.bgr); };
+  auto depth = [&] { synth::quantiseDepth(impl.renderer_.depth(), impl.sensor_, impl.noise_seed_, i, out.depth_raw); };
+  if (impl.renderer_.paintedFaces()) {
+    impl.renderer_.helper().runBoth(colour, depth);
+  } else {
+    colour();
+    depth();
+  }
   out.sequence = static_cast<uint64_t>(i);
   out.timestamp_s = timestamp(i);
   out.depth_timestamp_s = out.timestamp_s;
