@@ -7,9 +7,9 @@
 // visible to the caller. Handshake through two Doorbells (no mutex; no allocation after the
 // thread is started). Not reentrant: one caller thread at a time.
 //
-// Used by the synthetic renderer (drivers/synth/frame_renderer.h): lighting face i while face
-// i + 1 is painted, and shading half of the rows each, for the first frame's latency
-// (docs/EMBEDDED.md "First pose"). Both parts run the same code on the same inputs whichever
+// Used by the synthetic renderer (drivers/synth/frame_renderer.h) on frames that paint faces:
+// half of the faces painted by each thread, every other band of rows shaded by each, for the
+// first frame's latency (docs/EMBEDDED.md "First pose"). Both parts run the same code on the same inputs whichever
 // thread runs them, so results are byte-identical to one thread's.
 #include <atomic>
 #include <cstdint>

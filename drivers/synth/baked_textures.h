@@ -5,7 +5,8 @@
 // frame, most of it on faces that frame does not see. A texture depends only on its recipe and its
 // quad (never on when it is painted or what was painted before), so painting on first use gives
 // the same texels, and so the same frames, as painting everything at once. Not thread-safe: it
-// belongs to one FrameRenderer, which is itself used by one thread at a time.
+// belongs to one FrameRenderer, which is itself used by one thread at a time (prepareAll hands
+// half of its faces to the renderer's helper thread and returns when both halves are done).
 #include <vector>
 
 #include <opencv2/core.hpp>

@@ -102,9 +102,9 @@ TEST(SynthTextures, SimdTexelMultiplyEqualsSaturateCast) {
   }
 }
 
-// The renderer paints a frame's faces with prepareAll (face i lit on a helper thread while face
-// i + 1 is painted) into a canvas it lends (its colour buffer): the texels of prepare(), face by
-// face, on one thread with the textures' own canvas.
+// The renderer paints a frame's faces with prepareAll (shared between the caller and a helper
+// thread, each with its own scratch; the caller's canvas lent by the renderer, its colour
+// buffer): the texels of prepare(), face by face, on one thread with the textures' own canvas.
 TEST(SynthTextures, PaintingWithAHelperThreadAndALentCanvasGivesTheSameTexels) {
   for (const synth::SceneModel& model :
        {synth::buildRoom(synth::RoomLayoutOptions{}), synth::buildCorridor(synth::CorridorLayoutOptions{})}) {
