@@ -48,7 +48,13 @@ bool populateForWrite(void* data, std::size_t bytes) {
   std::uintptr_t first = 0, last = 0;
   wholePages(data, bytes, &first, &last);
   if (last <= first) return true;
-  return madvise(reinterpret_cast<void*>(first), last - first, MADV_POPULATE_WRITE) == 0;
+  void* const start = reinterpret_cast<void*>(first);
+  if (madvise(start, last - first, MADV_POPULATE_WRITE) != 0) return false;
+  // Some layers accept advice they do not act on (qemu-user returns success for any madvise it
+  // does not know): the last whole page must be resident now, or nothing was done.
+  unsigned char resident = 0;
+  void* const last_page = reinterpret_cast<void*>(last - pageBytes());
+  return mincore(last_page, pageBytes(), &resident) == 0 && (resident & 1) != 0;
 #else
   return false;
 #endif

@@ -21,7 +21,8 @@ namespace plumb {
 void makeResident(void* data, std::size_t bytes);
 // The same through the kernel only (MADV_POPULATE_WRITE on the whole pages inside the range):
 // never reads or writes a byte, so another thread may be using the memory meanwhile. False where
-// the kernel cannot (before Linux 5.14, other systems): nothing was done.
+// it was not done: the kernel cannot (before Linux 5.14, other systems), or an emulator accepted
+// the advice without acting on it (checked with mincore on the last page).
 bool populateForWrite(void* data, std::size_t bytes);
 
 class ResidencyQueue {

@@ -62,7 +62,10 @@ TEST(MemoryResidency, PopulateForWriteMapsWholePagesWithoutTouchingAByte) {
   m.data()[2 * page + 5] = 9;
   // From inside page 1 to inside page 9: whole pages 2..8 are populated; the partial pages at the
   // ends are left alone (it never touches a byte by hand).
-  if (!populateForWrite(m.data() + page + 10, 8 * page)) GTEST_SKIP() << "no MADV_POPULATE_WRITE (Linux < 5.14)";
+  if (!populateForWrite(m.data() + page + 10, 8 * page)) {
+    GTEST_SKIP() << "the kernel did not populate (no MADV_POPULATE_WRITE before Linux 5.14; "
+                    "qemu-user accepts the advice and ignores it)";
+  }
   EXPECT_EQ(m.residentPages(2 * page, 7 * page), 7u);
   EXPECT_EQ(m.residentPages(page, page), 0u);
   EXPECT_EQ(m.residentPages(9 * page, 7 * page), 0u);
