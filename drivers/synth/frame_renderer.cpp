@@ -33,10 +33,8 @@ int clipToNearPlane(const Eigen::Vector3d* in, int count, Eigen::Vector3d* out) 
   return n;
 }
 
-}  // namespace
-
-namespace {
 size_t pixelsOf(const PinholeCamera& camera) { return static_cast<size_t>(camera.width) * camera.height; }
+
 }  // namespace
 
 // Colour, depth and quad ids in one huge-page block (few page faults on the first frame). The
