@@ -102,7 +102,7 @@ Status drawHistograms(const runtime::RunReport& report, const std::string& path)
     drawPanel(canvas, i * kPanelHeight, report.stages[i].name, report.stages[i].latency, first, last);
   }
   drawPanel(canvas, (panels - 1) * kPanelHeight, "end-to-end", report.end_to_end, first, last);
-  return writePngFile(path, canvas, pngFastestOptions());
+  return writePngOutput(path, canvas, pngFastestOptions());
 }
 
 int profileCommand(int argc, char** argv) {
