@@ -73,7 +73,7 @@ Status checkFiles(const RunCommandOptions& o) {
   return io.check();
 }
 
-Status openSource(const RunCommandOptions& o, RunPlan* plan) {
+Status openSource(const RunCommandOptions& o, RunPlan* plan, bool* usage_error) {
   std::unique_ptr<FrameSource> source;
   if (o.synth_noise) {
     std::unique_ptr<SyntheticSource> synth;
@@ -86,6 +86,12 @@ Status openSource(const RunCommandOptions& o, RunPlan* plan) {
     if (o.max_frames > 0) open_options.max_frames = std::size_t(o.max_frames + o.skip_frames);
     PLUMB_RETURN_IF_ERROR(openFrameSource(o.dataset, o.camera, open_options, &source));
     if (auto* synth = dynamic_cast<SyntheticSource*>(source.get())) plan->scene = &synth->scene();
+  }
+  const std::size_t known = source->frameCount();
+  if (o.skip_frames > 0 && known > 0 && uint64_t(o.skip_frames) >= known) {
+    *usage_error = true;
+    return Status::Error("--skip-frames " + std::to_string(o.skip_frames) + " skips all " + std::to_string(known) +
+                         " frames of " + source->describe());
   }
   if (o.skip_frames > 0) source = std::make_unique<SkipFramesSource>(std::move(source), uint64_t(o.skip_frames));
   plan->source = std::move(source);
@@ -109,7 +115,7 @@ Status planRun(const RunCommandOptions& o, const std::atomic<bool>* stop, RunPla
     plan->map_read_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - read_start).count();
     plan->run_options.load_map = &plan->loaded_map;
   }
-  PLUMB_RETURN_IF_ERROR(openSource(o, plan));
+  PLUMB_RETURN_IF_ERROR(openSource(o, plan, usage_error));
 
   RunOutputOptions& out = plan->output_options;
   out.trajectory_path = o.out;
