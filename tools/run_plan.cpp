@@ -124,7 +124,9 @@ Status planRun(const RunCommandOptions& o, const std::atomic<bool>* stop, RunPla
   out.rss_every = long(o.rss_every);
   out.report_every = long(o.report_every);
   // Progress: on by default when someone watches (stderr is a terminal), never into a log file.
-  out.progress = o.progress || (!o.no_progress && ::isatty(STDERR_FILENO) == 1);
+  const bool terminal = ::isatty(STDERR_FILENO) == 1;
+  out.progress = o.progress || (!o.no_progress && terminal);
+  out.progress_on_terminal = terminal;
   out.trace = o.trace;
   // Only the ATE needs the poses in memory. A memory-profiling run (--rss-every) keeps nothing
   // per frame, so its resident size can stay flat; it reports no ATE for synthetic scenes.

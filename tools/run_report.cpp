@@ -201,8 +201,9 @@ int reportRun(const RunCommandOptions& o, const FlagTable& table, RunPlan& plan,
   if (record.run.stopped) {
     std::fprintf(stderr, "plumb run: stopped by signal %d after %llu frames; %s\n", stop_signal,
                  (unsigned long long)outputs.statistics().frames(),
-                 outputs.anyFile() && !record.outputs_kept ? "no frame was processed, no output was replaced"
-                                                          : "every pose computed was written");
+                 outputs.anyFile() && !record.outputs_kept
+                     ? "no frame was processed, so no trajectory file was replaced"
+                     : "every pose computed was written");
     return kExitStopped;
   }
   return kExitOk;

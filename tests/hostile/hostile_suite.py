@@ -37,26 +37,23 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 # ----------------------------------------------------------------------------------------------
 # Helpers to build inputs.
 
-def write_png16(path, width, height, value=0):
-    """A 16-bit greyscale PNG, every pixel `value` (e.g. a depth map with no reading)."""
-    row = b"\x00" + struct.pack(">H", value) * width
-    raw = row * height
+def write_png(path, width, height, bit_depth, colour_type, row):
+    """A PNG whose every row is `row` (filter byte included)."""
     def chunk(tag, data):
         return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data) & 0xFFFFFFFF)
-    data = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 16, 0, 0, 0, 0))
-    data += chunk(b"IDAT", zlib.compress(raw, 1)) + chunk(b"IEND", b"")
-    with open(path, "wb") as f:
-        f.write(data)
-
-
-def write_png8_rgb(path, width, height, grey=128):
-    row = b"\x00" + bytes([grey, grey, grey]) * width
-    def chunk(tag, data):
-        return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data) & 0xFFFFFFFF)
-    data = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0))
+    data = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, bit_depth, colour_type, 0, 0, 0))
     data += chunk(b"IDAT", zlib.compress(row * height, 1)) + chunk(b"IEND", b"")
     with open(path, "wb") as f:
         f.write(data)
+
+
+def write_png16(path, width, height, value=0):
+    """A 16-bit greyscale PNG, every pixel `value` (e.g. a depth map with no reading)."""
+    write_png(path, width, height, 16, 0, b"\x00" + struct.pack(">H", value) * width)
+
+
+def write_png8_rgb(path, width, height, grey=128):
+    write_png(path, width, height, 8, 2, b"\x00" + bytes([grey, grey, grey]) * width)
 
 
 def read_lines(path):
@@ -84,8 +81,8 @@ class Env:
         self.plumb = os.path.abspath(args.plumb)
         self.datasets = args.datasets
         self.python = args.python
-        self.python_dir = args.python_dir
-        self.jpeg_helper = args.jpeg_helper
+        self.python_dir = os.path.abspath(args.python_dir) if args.python_dir else ""
+        self.jpeg_helper = os.path.abspath(args.jpeg_helper) if args.jpeg_helper else ""
         self.work = work
         self._cache = {}
 
@@ -172,30 +169,62 @@ def map_sections(data):
     return out
 
 
-def craft_map_last_id(src, dst, new_id):
-    """The last keyframe's id set to new_id, the section CRC recomputed (loop edges untouched: they
-    name keyframes by id, so the map must have none naming the last one for this to stay valid)."""
-    data = bytearray(open(src, "rb").read())
+def map_keyframes(data):
+    """(section start, section size, [(offset, id)] of every keyframe) of a map's KFRM section."""
     for tag, start, size in map_sections(data):
         if tag != struct.unpack("<I", b"KFRM")[0]:
             continue
         n = struct.unpack_from("<I", data, start)[0]
-        pos, last = start + 4, None
+        pos, keyframes = start + 4, []
         for _ in range(n):
-            last = pos
+            keyframes.append((pos, struct.unpack_from("<I", data, pos)[0]))
             pos += MAP_KEYFRAME_FIXED
             points = struct.unpack_from("<I", data, pos)[0]
             pos += 4 + points * (24 + 1 + 32)
             lines = struct.unpack_from("<I", data, pos)[0]
             pos += 4
             for _ in range(lines):
-                samples = data[pos + 13]
-                pos += 12 + 2 + samples * 12 + 32
+                pos += 12 + 2 + data[pos + 13] * 12 + 32
         assert pos == start + size, "keyframe layout mismatch"
-        struct.pack_into("<I", data, last, new_id)
-        struct.pack_into("<I", data, start + size, crc32(bytes(data[start - 16:start + size])))
+        return start, size, keyframes
+    raise ValueError("no keyframe section")
+
+
+def craft_map_last_id(src, dst, new_id):
+    """The last keyframe's id set to new_id, the section CRC recomputed (loop edges untouched: they
+    name keyframes by id, so the map must have none naming the last one for this to stay valid)."""
+    data = bytearray(open(src, "rb").read())
+    start, size, keyframes = map_keyframes(data)
+    struct.pack_into("<I", data, keyframes[-1][0], new_id)
+    struct.pack_into("<I", data, start + size, crc32(bytes(data[start - 16:start + size])))
     with open(dst, "wb") as f:
         f.write(data)
+
+
+def craft_map_many_edges(src, dst, edges):
+    """The loop-edge section replaced by `edges` valid edges (identity pose and information)
+    between the first two keyframes: every field decodes, the loop closer's restore refuses it
+    (it keeps 24), i.e. a refusal that comes after the run has begun."""
+    data = bytes(open(src, "rb").read())
+    ids = [i for _, i in map_keyframes(data)[2]]
+    identity = [1.0 if r == c else 0.0 for r in range(3) for c in range(3)] + [0.0, 0.0, 0.0]
+    info = [1.0 if r == c else 0.0 for r in range(6) for c in range(6)]
+    edge = struct.pack("<II", ids[0], ids[1]) + struct.pack("<12d", *identity) + struct.pack("<36d", *info)
+    sections = []
+    for tag, start, size in map_sections(data):
+        payload = data[start:start + size]
+        if tag == struct.unpack("<I", b"LOOP")[0]:
+            payload = struct.pack("<I", edges) + edge * edges
+        sections.append((tag, payload))
+    body = b""
+    for tag, payload in sections:
+        head = struct.pack("<IIQ", tag, 0, len(payload))
+        body += head + payload + struct.pack("<I", crc32(head + payload))
+    header = bytearray(data[:32])
+    struct.pack_into("<Q", header, 16, 32 + len(body))
+    struct.pack_into("<I", header, 28, crc32(bytes(header[:28])))
+    with open(dst, "wb") as f:
+        f.write(bytes(header) + body)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -462,6 +491,11 @@ def setup_map_wrap(env, d):
     craft_map_last_id(env.good_map(), os.path.join(d, "wrap.map"), 0xFFFFFFF0)
 
 
+def setup_map_many_edges(env, d):
+    craft_map_many_edges(env.good_map(), os.path.join(d, "edges.map"), 30)
+    write_text(os.path.join(d, "good.txt"), "# a trajectory from an earlier run\n1000 0 0 0 0 0 0 1\n")
+
+
 def setup_map_other_camera(env, d):
     env.copy_dataset(d)
     shutil.copy(env.good_map(), os.path.join(d, "good.map"))
@@ -665,6 +699,9 @@ CASES = [
     # 15. Crafted CRC-valid maps: ids near 2^32 refused; a refused map replaces no --out.
     case(15, "map keyframe id near 2^32", RUN + SYN + ["--load-map", "{d}/wrap.map", "--out", "{d}/t.txt"],
          exit=1, msg="beyond 2147483647", setup=setup_map_wrap, check=check_absent("t.txt")),
+    case(15, "map refused while restoring (30 loop edges) keeps --out, says so",
+         RUN + SYN + ["--load-map", "{d}/edges.map", "--out", "{d}/good.txt"], exit=1,
+         msg="no output was written", setup=setup_map_many_edges),
     case(15, "map of another camera keeps --out",
          RUN + ["--dataset", "{d}/ds", "--camera", "tum3", "--load-map", "{d}/good.map", "--out", "{d}/good.txt"],
          exit=1, msg="another camera", setup=setup_map_other_camera,
