@@ -43,7 +43,7 @@ Status requireRegularFile(const std::string& path, const char* what) {
 
 std::string openErrorText(int error_number) {
   switch (error_number) {
-    case ENOENT: return "does not exist";
+    case ENOENT: return "missing (no such file)";
     case ELOOP: return "symlink loop (a link that points back to itself)";
     case EACCES: return "permission denied";
     case ENOTDIR: return "a part of the path is not a folder";

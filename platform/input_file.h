@@ -22,7 +22,7 @@ namespace plumb {
 enum class PathKind { kMissing, kRegular, kDirectory, kOther, kError };
 PathKind pathKind(const std::string& path);
 inline bool isRegularFile(const std::string& path) { return pathKind(path) == PathKind::kRegular; }
-// Ok when `path` is a regular file; otherwise why not, naming it: "does not exist", "symlink
+// Ok when `path` is a regular file; otherwise why not, naming it: "missing", "symlink
 // loop", "a FIFO (named pipe), not a regular file", ... (`what` prefixes the path: "image file").
 Status requireRegularFile(const std::string& path, const char* what);
 
@@ -55,7 +55,7 @@ class InputFile {
   std::string path_;
 };
 
-// Why `path` cannot be opened, from an errno: "does not exist", "symlink loop", ...
+// Why `path` cannot be opened, from an errno: "missing (no such file)", "symlink loop", ...
 std::string openErrorText(int error_number);
 
 // Reads a whole regular file of at most max_bytes into `bytes`.

@@ -111,13 +111,19 @@ void RunOutputs::progressLine(uint64_t frame, const FrameOutput& out) {
   progress_last_ns_ = now;
   const double seconds = double(now - progress_start_ns_) * 1e-9;
   const double fps = seconds > 0 ? double(frame) / seconds : 0.0;
-  char eta[96] = "";
-  if (options_.expected_frames >= frame && options_.expected_frames > 0 && fps > 0) {
-    const long long left = std::llround(double(options_.expected_frames - frame) / fps);
-    std::snprintf(eta, sizeof eta, "/%zu, ETA %lld:%02lld", options_.expected_frames, left / 60, left % 60);
+  char count[64], eta[48] = "";
+  const std::size_t total = options_.expected_frames;
+  if (total >= frame && total > 0) {
+    std::snprintf(count, sizeof count, "frame %" PRIu64 "/%zu (%.0f%%)", frame, total, 100.0 * double(frame) / double(total));
+    if (fps > 0) {
+      const long long left = std::llround(double(total - frame) / fps);
+      std::snprintf(eta, sizeof eta, ", ETA %lld:%02lld", left / 60, left % 60);
+    }
+  } else {
+    std::snprintf(count, sizeof count, "frame %" PRIu64, frame);
   }
-  std::fprintf(stderr, "%sframe %" PRIu64 "%s, %.1f frames/s: %s, keyframes %" PRIu64 ", without pose %" PRIu64 "%s",
-               options_.progress_on_terminal ? "\r" : "", frame, eta, fps, toString(out.state), keyframes_, lost_,
+  std::fprintf(stderr, "%s%s, %.1f frames/s%s: %s, keyframes %" PRIu64 ", without pose %" PRIu64 "%s",
+               options_.progress_on_terminal ? "\r" : "", count, fps, eta, toString(out.state), keyframes_, lost_,
                options_.progress_on_terminal ? "\x1b[K" : "\n");
   progress_line_open_ = options_.progress_on_terminal;
 }

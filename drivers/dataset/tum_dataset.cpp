@@ -115,9 +115,14 @@ Status TumDatasetSource::open(const std::string& dir, const PinholeCamera& camer
   const std::string lists = source->used_associations_file_ ? "associations.txt" : "rgb.txt/depth.txt";
   for (const TumFrameEntry& frame : source->frames_) {
     for (const std::string* relative : {&frame.rgb_path, &frame.depth_path}) {
-      // "does not exist", "symlink loop", "a FIFO": the reason, not a guess.
-      PLUMB_RETURN_IF_ERROR(requireRegularFile(dir + "/" + *relative, "image file")
-                                .withContext("listed in " + dir + "/" + lists));
+      // Missing, a symlink loop, a FIFO: the reason, not a guess.
+      const std::string path = dir + "/" + *relative;
+      const Status present = requireRegularFile(path, "");
+      if (!present.ok()) {
+        if (pathKind(path) == PathKind::kMissing)
+          return Status::Error(path + ": missing image file (listed in " + lists + ")");
+        return Status::Error(present.message() + " (an image file listed in " + lists + ")");
+      }
     }
     // Full paths once, so loading a frame builds no strings.
     source->rgb_files_.push_back(dir + "/" + frame.rgb_path);
