@@ -775,7 +775,7 @@ def run_case(env, c, folder):
                     close_stderr_after_line=close_after_line)
     problems = []
     if r.code == "timeout":
-        problems.append("did not end within %d s" % c["timeout"])
+        problems.append("did not end within %.0f s" % c["timeout"])
     elif r.code != c["exit"]:
         problems.append("exit %s, expected %d" % (r.code, c["exit"]))
     if isinstance(r.code, int) and (r.code < 0 or r.code == 70) and c["exit"] not in (r.code,):
@@ -783,7 +783,7 @@ def run_case(env, c, folder):
     if c["msg"] and c["msg"].lower() not in r.output.lower():
         problems.append("message lacks '%s'" % c["msg"])
     if c["mem_mb"] is not None and r.max_rss_kib > c["mem_mb"] * 1024:
-        problems.append("peak RSS %.0f MB > %d MB" % (r.max_rss_kib / 1024.0, c["mem_mb"]))
+        problems.append("peak RSS %.0f MB > %.0f MB" % (r.max_rss_kib / 1024.0, c["mem_mb"]))
     after = snapshot(folder, c["outputs"])
     changed = sorted(os.path.relpath(p, folder) for p in set(before) | set(after)
                      if before.get(p) != after.get(p) and not os.path.basename(p).startswith("."))
@@ -818,11 +818,21 @@ def main():
     parser.add_argument("--only", default="")
     parser.add_argument("--list", action="store_true")
     parser.add_argument("--keep", action="store_true", help="keep the scratch folders")
+    parser.add_argument("--time-scale", type=float, default=1.0,
+                        help="multiply every time limit (an emulated cross build runs ~10x slower)")
+    parser.add_argument("--memory-slack-mb", type=float, default=0.0,
+                        help="added to every memory bound (an emulator's own resident memory)")
     args = parser.parse_args()
     if args.list:
         for c in CASES:
             print("%2d  %s" % (c["cls"], c["name"]))
         return 0
+    for c in CASES:
+        c["timeout"] *= args.time_scale
+        if c["mem_mb"] is not None:
+            c["mem_mb"] += args.memory_slack_mb
+        if c["signal"]:
+            c["signal"] = (c["signal"][0], c["signal"][1] * args.time_scale)
     work = tempfile.mkdtemp(prefix="plumb_hostile_")
     env = Env(args, work)
     results = {"PASS": 0, "FAIL": 0, "SKIP": 0}
