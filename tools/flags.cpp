@@ -61,42 +61,39 @@ Status parseRealValue(const std::string& flag, const std::string& text, double m
   return Status::Ok();
 }
 
-FlagTable& FlagTable::toggle(const char* name, bool* target, const char* help) {
+FlagTable::Flag& FlagTable::add(Kind kind, const char* name, const char* value_name, void* target, const char* help) {
   Flag f;
-  f.name = name, f.help = help, f.kind = Kind::kToggle, f.target = target;
+  f.kind = kind, f.name = name, f.value_name = value_name, f.target = target, f.help = help;
   flags_.push_back(f);
+  return flags_.back();
+}
+
+FlagTable& FlagTable::toggle(const char* name, bool* target, const char* help) {
+  add(Kind::kToggle, name, "", target, help);
   return *this;
 }
 
 FlagTable& FlagTable::integer(const char* name, const char* value_name, long long min, long long max, long long* target,
                               const char* help) {
-  Flag f;
-  f.name = name, f.value_name = value_name, f.help = help, f.kind = Kind::kInteger, f.target = target;
+  Flag& f = add(Kind::kInteger, name, value_name, target, help);
   f.int_min = min, f.int_max = max;
-  flags_.push_back(f);
   return *this;
 }
 
 FlagTable& FlagTable::real(const char* name, const char* value_name, double min, double max, double* target,
                            const char* help) {
-  Flag f;
-  f.name = name, f.value_name = value_name, f.help = help, f.kind = Kind::kReal, f.target = target;
+  Flag& f = add(Kind::kReal, name, value_name, target, help);
   f.real_min = min, f.real_max = max;
-  flags_.push_back(f);
   return *this;
 }
 
 FlagTable& FlagTable::text(const char* name, const char* value_name, std::string* target, const char* help) {
-  Flag f;
-  f.name = name, f.value_name = value_name, f.help = help, f.kind = Kind::kText, f.target = target;
-  flags_.push_back(f);
+  add(Kind::kText, name, value_name, target, help);
   return *this;
 }
 
 FlagTable& FlagTable::section(const char* heading) {
-  Flag f;
-  f.help = heading, f.kind = Kind::kSection;
-  flags_.push_back(f);
+  add(Kind::kSection, "", "", nullptr, heading);
   return *this;
 }
 

@@ -62,6 +62,7 @@ class FlagTable {
     void* target = nullptr;
     bool given = false;
   };
+  Flag& add(Kind kind, const char* name, const char* value_name, void* target, const char* help);
   Flag* find(const std::string& name);
   Status apply(Flag& flag, const std::string& value);
 

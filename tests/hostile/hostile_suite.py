@@ -419,17 +419,22 @@ def setup_sparse_map(env, d):
         f.truncate(900 << 20)  # 900 MB of zeros (sparse): not a map, refused after 32 bytes
 
 
-def setup_realtime_gap(env, d):
-    ds = env.copy_dataset(d)
-    lines = data_lines(os.path.join(ds, "associations.txt"))
+def rewrite_associations(ds, edit):
+    """associations.txt with edit(index, fields) applied to each data line (comments dropped)."""
+    path = os.path.join(ds, "associations.txt")
     out = []
-    for i, l in enumerate(lines):
-        f = l.split()
+    for i, line in enumerate(data_lines(path)):
+        fields = line.split()
+        edit(i, fields)
+        out.append(" ".join(fields))
+    write_text(path, "\n".join(out) + "\n")
+
+
+def setup_realtime_gap(env, d):
+    def shift(i, f):
         if i >= 5:
-            shifted = "%.6f" % (float(f[0]) + 1e6)  # a recorded gap of 11.6 days before frame 5
-            f[0] = f[2] = shifted
-        out.append(" ".join(f))
-    write_text(os.path.join(ds, "associations.txt"), "\n".join(out) + "\n")
+            f[0] = f[2] = "%.6f" % (float(f[0]) + 1e6)  # a recorded gap of 11.6 days before frame 5
+    rewrite_associations(env.copy_dataset(d), shift)
 
 
 def setup_bom(env, d):
@@ -451,19 +456,16 @@ def setup_symlink_loop_image(env, d):
 def setup_jpeg(truncate):
     def setup(env, d):
         ds = env.copy_dataset(d)
-        lines = data_lines(os.path.join(ds, "associations.txt"))
-        out = []
-        for i, l in enumerate(lines):
-            f = l.split()
-            if i == 2:
-                jpg = os.path.join(ds, "rgb", "frame2.jpg")
-                env.run_setup([env.jpeg_helper, jpg, "640", "480"])
-                if truncate:
-                    data = open(jpg, "rb").read()
-                    open(jpg, "wb").write(data[: len(data) * 2 // 3])
-                f[1] = "rgb/frame2.jpg"
-            out.append(" ".join(f))
-        write_text(os.path.join(ds, "associations.txt"), "\n".join(out) + "\n")
+        def use_jpeg(i, f):
+            if i != 2:
+                return
+            jpg = os.path.join(ds, "rgb", "frame2.jpg")
+            env.run_setup([env.jpeg_helper, jpg, "640", "480"])
+            if truncate:
+                data = open(jpg, "rb").read()
+                open(jpg, "wb").write(data[: len(data) * 2 // 3])
+            f[1] = "rgb/frame2.jpg"
+        rewrite_associations(ds, use_jpeg)
     return setup
 
 
