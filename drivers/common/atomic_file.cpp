@@ -34,9 +34,23 @@ std::string writeErrorText(int error_number) {
 
 }  // namespace
 
+// /dev/stdout, /dev/fd/N, /proc/self/fd/N, /proc/<pid>/fd/N: a stream of this process, not a
+// file. An output cannot be written aside and renamed onto a stream (renaming onto the file behind
+// a redirected stdout would also swap the file from under the shell), so it is refused.
+bool namesProcessStream(const std::string& path) {
+  if (path.rfind("/dev/fd/", 0) == 0 || path == "/dev/stdout" || path == "/dev/stderr" || path == "/dev/stdin") return true;
+  if (path.rfind("/proc/", 0) != 0) return false;
+  const std::size_t fd = path.find("/fd/");
+  return fd != std::string::npos && path.find('/', fd + 4) == std::string::npos;
+}
+
 Status resolveOutputTarget(const std::string& path, std::string* target) {
   std::string current = path;
   for (int hop = 0; hop <= kMaxSymlinkHops; ++hop) {
+    if (namesProcessStream(current)) {
+      return Status::Error(path + ": names a stream of this process (" + current +
+                           "), not a file; outputs are written aside and renamed into place: give a file path");
+    }
     struct stat st {};
     if (::lstat(current.c_str(), &st) != 0) {
       if (errno == ENOENT) break;  // a new file (possibly a dangling link's target)

@@ -8,7 +8,9 @@
 // A path that is a symlink is written THROUGH the link: the chain is followed to its final target
 // (which may not exist yet) and the temporary file and the rename happen there, so the link stays a
 // link (`--out /dev/stdout` as root used to replace the /dev/stdout link by a regular file). A link
-// chain longer than 40 hops or pointing back to itself is refused as a symlink loop.
+// chain longer than 40 hops or pointing back to itself is refused as a symlink loop, and a path
+// that is (or leads to) a stream of the process (/dev/stdout, /dev/fd/N, /proc/self/fd/N) is
+// refused: an output that appears whole by rename cannot be a stream.
 #include <cstddef>
 #include <cstdio>
 #include <string>

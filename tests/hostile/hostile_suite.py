@@ -598,6 +598,9 @@ CASES = [
          outputs=["new.txt"], check=check_is_link("link.txt", "new.txt")),
     case(1, "--out symlink loop: refused as a loop", RUN + SYN + ["--out", "{d}/loop.txt"], exit=2,
          msg="symlink loop", setup=lambda e, d: os.symlink("loop.txt", os.path.join(d, "loop.txt"))),
+    case(1, "--out link to /proc/self/fd/1 (a redirected stdout): refused, link kept",
+         RUN + SYN + ["--out", "{d}/stdout_link.txt"], exit=2, msg="stream of this process",
+         setup=lambda e, d: os.symlink("/proc/self/fd/1", os.path.join(d, "stdout_link.txt"))),
     # 2. Python: concurrent track() on one object is refused (RuntimeError), never a crash.
     case(2, "python: three threads on one Odometry", python=PY_CONCURRENT, timeout=300),
     # 3. eval --plot / profile --png never overwrite an input.
