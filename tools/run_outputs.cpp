@@ -48,7 +48,7 @@ RunOutputs::~RunOutputs() {
   if (frames_stream_ != nullptr) std::fclose(frames_stream_);
 }
 
-Status RunOutputs::open() {
+Status RunOutputs::begin(const OdometrySystem&) {
   if (!options_.optimized_path.empty()) {
     frames_stream_ = std::tmpfile();
     if (frames_stream_ == nullptr) return Status::Error("--out-optimized: cannot create a temporary file");
@@ -59,6 +59,7 @@ Status RunOutputs::open() {
     mavlink_ = std::make_unique<MavlinkOdometrySink>();
     PLUMB_RETURN_IF_ERROR(mavlink_->open(options_.mavlink).withContext("--mavlink"));
   }
+  opened_ = true;
   return Status::Ok();
 }
 
@@ -79,6 +80,7 @@ void RunOutputs::onPose(const FrameOutput& out) {
 }
 
 Status RunOutputs::close() {
+  if (!opened_) return Status::Ok();
   if (!options_.trajectory_path.empty()) PLUMB_RETURN_IF_ERROR(trajectory_writer_.close());
   if (!options_.covariance_path.empty()) PLUMB_RETURN_IF_ERROR(covariance_writer_.close());
   return Status::Ok();
@@ -184,19 +186,15 @@ Status RunOutputs::onRetiredKeyframe(const RetiredKeyframe& kf) {
 
 Status runToOutputs(FrameSource& source, const SystemOptions& system_options, const OdometryRunOptions& run_options,
                     RunOutputs& outputs, RunRecord* record) {
-  std::unique_ptr<OdometrySystem> system;
-  PLUMB_RETURN_IF_ERROR(OdometrySystem::create(source.camera(), system_options, &system));
-  PLUMB_RETURN_IF_ERROR(validate(run_options));
-  PLUMB_RETURN_IF_ERROR(outputs.open());
   SourceCapture capture(source);
-  Status status = runOdometry(capture, *system, outputs, run_options, &record->run);
+  Status status = runOdometry(capture, system_options, outputs, run_options, &record->run);
   const Status closed = outputs.close();
   if (status.ok()) status = closed;
   const Status optimized = outputs.writeOptimized(record->run.loop);
   if (status.ok()) status = optimized;
-  record->odometry = system->stats();
-  record->mapper = system->mapperStats();
-  record->mapper_waits = system->mapperWaits();
+  record->odometry = record->run.odometry;
+  record->mapper = record->run.mapper;
+  record->mapper_waits = record->run.mapper_waits;
   return status;
 }
 

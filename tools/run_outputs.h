@@ -39,8 +39,8 @@ class RunOutputs final : public OdometrySink {
  public:
   explicit RunOutputs(const RunOutputOptions& options);
   ~RunOutputs() override;
-  Status open();   // the files
-  Status close();  // flushes and closes them
+  Status begin(const OdometrySystem&) override;  // opens the files (the run has been checked)
+  Status close();  // flushes and closes them (nothing when they were never opened)
 
   void onPose(const FrameOutput& frame) override;
   Status onFrame(const FrameOutput& frame) override;
@@ -62,6 +62,7 @@ class RunOutputs final : public OdometrySink {
   void reportBlock(const FrameOutput& frame);
 
   RunOutputOptions options_;
+  bool opened_ = false;
   TumTrajectoryWriter trajectory_writer_;
   CovarianceWriter covariance_writer_;
   std::vector<StampedPose> trajectory_;
@@ -88,8 +89,9 @@ struct RunRecord {
   uint64_t mapper_waits = 0;  // threaded runs: times tracking waited for a lagging map stage
 };
 
-// Builds the system (options validated there), runs it over `source` through the one runner into
-// `outputs` (opened first, closed after, also when the run failed: what was computed is kept).
+// Runs `source` through runOdometry() (pipeline/run/odometry_run.h: system, session, runner) into
+// `outputs` (opened when the run has been checked, closed after, also when the run failed part-way:
+// what was computed is kept; a run refused before its first frame leaves no file).
 Status runToOutputs(FrameSource& source, const SystemOptions& system_options, const OdometryRunOptions& run_options,
                     RunOutputs& outputs, RunRecord* record);
 

@@ -109,8 +109,6 @@ Status runMode(const std::string& dir, long frames, runtime::RunMode mode, const
                Trajectory* out, OdometryRunResult* result, int realtime_priority = 0, bool loop_closing = true) {
   std::unique_ptr<FrameSource> source;
   PLUMB_RETURN_IF_ERROR(open(dir, &source));
-  std::unique_ptr<OdometrySystem> system;
-  PLUMB_RETURN_IF_ERROR(OdometrySystem::create(source->camera(), SystemOptions{}, &system));
   OdometryRunOptions options;
   options.schedule.mode = mode;
   options.schedule.realtime_priority = realtime_priority;
@@ -124,7 +122,7 @@ Status runMode(const std::string& dir, long frames, runtime::RunMode mode, const
   if (fifo_here) (void)applyThreadSettings(ThreadSettings{"", -1, realtime_priority});
   const double cpu_start = processCpuSeconds();
   const int64_t start = monotonicNowNs();
-  const Status status = runOdometry(capture, *system, sink, options, result);
+  const Status status = runOdometry(capture, SystemOptions{}, sink, options, result);
   out->seconds = static_cast<double>(monotonicNowNs() - start) * 1e-9;
   out->cpu_seconds = processCpuSeconds() - cpu_start;
   if (fifo_here) normalScheduling();

@@ -30,12 +30,16 @@ class MapperFence {
   int maxFramesAhead() const { return max_frames_ahead_; }
 
   // Tracking thread: while frame number framesTracked() is being tracked.
-  void waitForMapper() {
-    if (!threaded_) return;
-    bell_.waitUntil([this] {
-      return failed_.load(std::memory_order_acquire) ||
-             frames_mapped_.load(std::memory_order_acquire) >= frames_tracked_;
-    });
+  void waitForMapper() { (void)waitUntilMapped(frames_tracked_); }
+  // Tracking thread: returns once the first `frames` frames have been through the map stage (or
+  // it failed); true when that meant waiting.
+  bool waitUntilMapped(uint64_t frames) {
+    auto done = [this, frames] {
+      return failed_.load(std::memory_order_acquire) || frames_mapped_.load(std::memory_order_acquire) >= frames;
+    };
+    if (!threaded_ || done()) return false;
+    bell_.waitUntil(done);
+    return true;
   }
   // Tracking thread: after each frame.
   void frameTracked() { ++frames_tracked_; }

@@ -74,15 +74,28 @@ Status TrackStage::process(OdometrySlot& slot, const runtime::FrameStamps&) {
 // ---------------------------------------------------------------------------------------------
 // MapStage
 
-Status MapStage::deliver(const FrameOutput& out) {
-  Status status = sink_.onFrame(out);
-  system_.drainFinishedFrames([&](const FinishedFrame& f) {
-    if (status.ok()) status = sink_.onFinishedFrame(f);
-  });
+void MapStage::drain(bool end_of_run, Status* status) {
+  system_.drainFinishedFrames(
+      [&](const FinishedFrame& f) {
+        if (status->ok()) *status = sink_.onFinishedFrame(f);
+      },
+      end_of_run);
+  if (end_of_run) system_.retireAllKeyframes();
   system_.drainRetiredKeyframes([&](const RetiredKeyframe& kf) {
     if (loop_ != nullptr) loop_->keyframeRetired(kf, system_.stats().loop_corrections_applied);
-    if (status.ok()) status = sink_.onRetiredKeyframe(kf);
+    if (status->ok()) *status = sink_.onRetiredKeyframe(kf);
   });
+}
+
+Status MapStage::deliver(const FrameOutput& out) {
+  Status status = sink_.onFrame(out);
+  drain(false, &status);
+  return status;
+}
+
+Status MapStage::deliverTheRest() {
+  Status status;
+  drain(true, &status);
   return status;
 }
 

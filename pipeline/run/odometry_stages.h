@@ -104,6 +104,9 @@ class MapStage final : public runtime::Stage<OdometrySlot> {
   // Frames dropped after the last processed one (the capture has finished).
   void finish() override;
   const Status& finishStatus() const { return finish_status_; }
+  // The end of a run, after finish() and the loop stage's last correction: every frame held back
+  // for refinement and then every keyframe reach the sink (and retired keyframes the loop stage).
+  Status deliverTheRest();
   uint64_t frames() const { return frames_; }
   uint64_t framesDropped() const { return frames_dropped_; }
   uint64_t framesAfterWarmup() const { return frames_after_warmup_; }
@@ -112,6 +115,9 @@ class MapStage final : public runtime::Stage<OdometrySlot> {
  private:
   Status writeDrops(uint32_t count);
   Status deliver(const FrameOutput& out);
+  // Finished frames, then retired keyframes, to the sink; a failure is kept in *status (the first
+  // one), after which the sink hears of nothing more.
+  void drain(bool end_of_run, Status* status);
 
   OdometrySystem& system_;
   MapperFence& fence_;
