@@ -1,5 +1,5 @@
 // plumb_bench_odometry_vs_opencv [DATASET|synth:PRESET] [--frames N] [--repeat N] [--rt-priority P]
-//                               [--map-lag L] [--no-opencv]
+//                               [--map-lag L] [--no-opencv] [--synth-noise]
 // The whole odometry against OpenCV's RgbdOdometry (contrib `rgbd`: dense photometric + depth
 // odometry, the stock RGB-D odometry of OpenCV), in ONE run, on the SAME frames, decoded once into
 // memory beforehand so that no PNG decoding is timed for either side:
@@ -14,7 +14,8 @@
 //      lock-step / fast wall (the threads' speed-up; target >= 1.7 on two cores), and the ATE of
 //      each trajectory when the folder has groundtruth.txt (synthetic scenes: the exact path).
 // --map-lag L sets SystemOptions::map_lag_frames (default: the system's default) to measure what
-// the fixed lag of map updates costs in accuracy and buys in fast mode's speed; --no-opencv skips (3).
+// the fixed lag of map updates costs in accuracy and buys in fast mode's speed; --no-opencv skips (3);
+// --synth-noise renders a synth:PRESET with Kinect-like depth and pixel noise (as `plumb run`'s).
 // --repeat N (default 3) alternates the three N times and keeps each one's fastest run: other jobs
 // on a shared machine only ever slow a run down. --rt-priority P runs them SCHED_FIFO (the lock-step
 // and OpenCV runs on this thread, fast mode's stage threads), as on an otherwise idle machine.
@@ -182,6 +183,7 @@ int main(int argc, char** argv) {
   int rt_priority = 0;
   SystemOptions system_options;
   bool with_opencv = true;
+  bool synth_noise = false;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) {
       max_frames = std::atol(argv[++i]);
@@ -193,10 +195,12 @@ int main(int argc, char** argv) {
       system_options.map_lag_frames = std::atoi(argv[++i]);
     } else if (!std::strcmp(argv[i], "--no-opencv")) {
       with_opencv = false;
+    } else if (!std::strcmp(argv[i], "--synth-noise")) {
+      synth_noise = true;
     } else if (argv[i][0] == '-') {
       std::fprintf(stderr,
                    "usage: plumb_bench_odometry_vs_opencv [DATASET|synth:PRESET] [--frames N] [--repeat N] "
-                   "[--rt-priority P] [--map-lag L] [--no-opencv]\n");
+                   "[--rt-priority P] [--map-lag L] [--no-opencv] [--synth-noise]\n");
       return 2;
     } else {
       dir = argv[i];
@@ -211,7 +215,13 @@ int main(int argc, char** argv) {
 
   // The frames, decoded once.
   std::unique_ptr<FrameSource> source;
-  check(openFrameSource(dir, "", &source));
+  if (synth_noise) {
+    std::unique_ptr<SyntheticSource> synth;
+    check(openSynthSpec(dir, true, &synth));
+    source = std::move(synth);
+  } else {
+    check(openFrameSource(dir, "", &source));
+  }
   const PinholeCamera camera = source->camera();
   std::vector<RgbdImage> frames;
   for (;;) {
@@ -252,18 +262,23 @@ int main(int argc, char** argv) {
   }
 
   std::printf("%-40s %10s %10s %10s\n", "", "wall ms/f", "CPU ms/f", "ATE m");
-  std::printf("%-40s %10.2f %10.2f %10.4f\n", "plumb lock-step (deterministic, 1 core)", lock_step.wall_ms_per_frame,
+  std::printf("%-40s %10.2f %10.2f %10.5f\n", "plumb lock-step (deterministic, 1 core)", lock_step.wall_ms_per_frame,
               lock_step.cpu_ms_per_frame, ateOrNan(ground_truth, lock_step_poses));
-  std::printf("%-40s %10.2f %10.2f %10.4f\n", "plumb fast (a thread per stage)", fast.wall_ms_per_frame,
+  std::printf("%-40s %10.2f %10.2f %10.5f\n", "plumb fast (a thread per stage)", fast.wall_ms_per_frame,
               fast.cpu_ms_per_frame, ateOrNan(ground_truth, fast_poses));
-  std::printf("%-40s %10.2f %10.2f %10.4f\n", "OpenCV RgbdOdometry (1 thread)", rgbd.wall_ms_per_frame,
-              rgbd.cpu_ms_per_frame, ateOrNan(ground_truth, rgbd_poses));
+  if (with_opencv) {
+    std::printf("%-40s %10.2f %10.2f %10.5f\n", "OpenCV RgbdOdometry (1 thread)", rgbd.wall_ms_per_frame,
+                rgbd.cpu_ms_per_frame, ateOrNan(ground_truth, rgbd_poses));
+  }
   std::printf("fast trajectory byte-identical to lock-step (every run): %s\n", fast_identical ? "yes" : "NO");
-  std::printf("RgbdOdometry / plumb lock-step, one core each: %.2fx wall, %.2fx CPU (target >= 4)\n",
-              rgbd.wall_ms_per_frame / lock_step.wall_ms_per_frame, rgbd.cpu_ms_per_frame / lock_step.cpu_ms_per_frame);
+  if (with_opencv) {
+    std::printf("RgbdOdometry / plumb lock-step, one core each: %.2fx wall, %.2fx CPU (target >= 4)\n",
+                rgbd.wall_ms_per_frame / lock_step.wall_ms_per_frame,
+                rgbd.cpu_ms_per_frame / lock_step.cpu_ms_per_frame);
+  }
   std::printf("plumb fast over lock-step throughput: %.2fx (target >= 1.7 on 2 cores; %.1f vs %.1f frames/s)\n",
               lock_step.wall_ms_per_frame / fast.wall_ms_per_frame, 1e3 / fast.wall_ms_per_frame,
               1e3 / lock_step.wall_ms_per_frame);
-  std::printf("RgbdOdometry / plumb fast wall: %.2fx\n", rgbd.wall_ms_per_frame / fast.wall_ms_per_frame);
+  if (with_opencv) std::printf("RgbdOdometry / plumb fast wall: %.2fx\n", rgbd.wall_ms_per_frame / fast.wall_ms_per_frame);
   return fast_identical ? 0 : 1;
 }

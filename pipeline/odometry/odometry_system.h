@@ -85,9 +85,11 @@ struct SystemOptions {
   // LocalMap snapshot the mapping side makes from frame k's keyframe request is tracked against
   // from frame k + map_lag_frames on, in the deterministic and fast schedules alike, so both write
   // the same bytes; until then the request is pending and the tracker makes no keyframe decision.
-  // 1 = from the next frame (fast mode then cannot track while a keyframe is being mapped). A new
-  // map (first frame, new segment) is used from the next frame on whatever the lag. Real-time
-  // mode tracks on the newest snapshot instead (OdometryRunOptions::max_frames_ahead_of_mapper).
+  // 1 (default) = from the next frame: fast mode then waits for each keyframe's mapping before
+  // the next frame. L > 1 lets it track L - 1 frames meanwhile, but costs accuracy (low texture
+  // with noise: ATE 3.3x at L = 3; docs/RUNTIME.md "Map updates at a fixed lag"). A new map (first
+  // frame, new segment) is used from the next frame on whatever the lag. Real-time mode tracks on
+  // the newest snapshot instead (OdometryRunOptions::max_frames_ahead_of_mapper).
   int map_lag_frames = kDefaultMapLagFrames;
   static constexpr int kDefaultMapLagFrames = 1;
   static constexpr int kMaxMapLagFrames = 16;

@@ -17,11 +17,13 @@
 //   deterministic: lock-step on the calling thread, one frame through all stages before the next
 //     is read. This IS the single-threaded program: every frame sees exactly the map the previous
 //     frames left, so the output is byte-identical run after run.
-//   fast: a thread per stage over SPSC rings, capture and extract working ahead, but the tracker
-//     never runs past a keyframe it asked for (max_frames_ahead_of_mapper 0) and the loop stage
-//     runs on the map stage's thread: every frame is tracked against exactly the map lock-step
-//     would have, so the output is the deterministic output, byte for byte, however loaded the CPU
-//     (only the speed changes). Throughput comes from extraction overlapping track + map.
+//   fast: a thread per stage over SPSC rings, capture and extract working ahead; the map update a
+//     keyframe request of frame k asked for is used from frame k + SystemOptions::map_lag_frames on
+//     as in lock-step (the tracker waits there if the map stage is behind; max_frames_ahead_of_mapper
+//     0) and the loop stage runs on the map stage's thread: every frame is tracked against exactly
+//     the map lock-step would have, so the output is the deterministic output, byte for byte,
+//     however loaded the CPU (only the speed changes). Throughput comes from extraction
+//     overlapping track + map, and tracking overlapping the map stage for the lag's frames.
 //   realtime: a thread per stage; latency first: the tracker may run up to 4 frames past a pending
 //     keyframe on the newest published snapshot (timing dependent), the loop stage has its own
 //     thread. Paces the capture to the recorded timestamps and drops (and counts, and writes as
@@ -82,11 +84,12 @@ struct OdometryRunOptions {
   // on head250 and synth:repeated it accepts no loop (docs/LOOP.md "Measurements").
   bool loop_closing = true;
   loop::LoopCloserOptions loop;
-  // Threaded runs: frames the tracker may track past a keyframe it asked for before it waits for
-  // the map stage to publish it (bounded staleness, docs/RUNTIME.md "When the map stage falls
-  // behind"). -1 (default): by mode, 0 in fast (lock-step's map, the deterministic bytes) and
-  // kRealtimeFramesAhead in realtime (the tracker does not wait for a local BA; a lagging mapper
-  // backs up into the slot pool and frames drop, counted). Lock-step never waits.
+  // How tracking follows the map stage (docs/RUNTIME.md "When the map stage falls behind"). 0: at
+  // the fixed lag SystemOptions::map_lag_frames, lock-step's map, the deterministic bytes. > 0: the
+  // newest snapshot, tracking at most this many frames past a keyframe it asked for before it
+  // waits for the map stage to publish it (bounded staleness). -1 (default): by mode, 0 in
+  // deterministic and fast, kRealtimeFramesAhead in realtime (the tracker does not wait for a
+  // local BA; a lagging mapper backs up into the slot pool and frames drop, counted).
   int max_frames_ahead_of_mapper = -1;
   static constexpr int kRealtimeFramesAhead = 4;
   // Map files (docs/LOOP.md "Map files"). load_map: the run starts relocalizing into this map (its

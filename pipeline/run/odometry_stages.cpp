@@ -48,10 +48,16 @@ void CaptureStage::skip() {
 // ---------------------------------------------------------------------------------------------
 // ExtractStage, TrackStage
 
-ExtractStage::ExtractStage(const OdometrySystem& system)
-    : extractor_(system.camera(), system.options().odometry.extractor) {}
+ExtractStage::ExtractStage(const OdometrySystem& system, uint32_t stride, uint32_t offset)
+    : extractor_(system.camera(), system.options().odometry.extractor), stride_(stride), offset_(offset) {}
 
-Status ExtractStage::process(OdometrySlot& slot, const runtime::FrameStamps&) {
+const char* ExtractStage::name() const {
+  if (stride_ == 1) return "extract";
+  return offset_ == 0 ? "extract-even" : "extract-odd";
+}
+
+Status ExtractStage::process(OdometrySlot& slot, const runtime::FrameStamps& stamps) {
+  if (stamps.frame_index % stride_ != offset_) return Status::Ok();
   const auto start = std::chrono::steady_clock::now();
   // A frame that does not fit the camera is tracked featureless (and counted): it keeps its place.
   if (!extractor_.extract(slot.image, *slot.features)) {

@@ -45,7 +45,10 @@ RunSession::RunSession(std::unique_ptr<OdometrySystem> system, OdometrySink& sin
       system_(std::move(system)),
       sink_(sink),
       fence_(fenceFor(options)),
-      extract_(*system_),
+      // Threaded: two extract stages, even and odd frames, so that extraction (the largest stage,
+      // about half of a frame's work) is not the pipeline's bottleneck on two cores.
+      extract_(*system_, oneThread(options.schedule) ? 1 : 2, 0),
+      extract_odd_(oneThread(options.schedule) ? nullptr : std::make_unique<ExtractStage>(*system_, 2, 1)),
       track_(*system_, fence_, sink),
       loop_(loopStageFor(*system_, options)),
       map_(*system_, fence_, drops_, sink, options.warmup_frames, loop_.get()) {}
@@ -95,6 +98,10 @@ Status RunSession::restoreLoadedMap() {
   return Status::Ok();
 }
 
+uint64_t RunSession::extractionFailures() const {
+  return extract_.failures() + (extract_odd_ ? extract_odd_->failures() : 0);
+}
+
 Status RunSession::run(FrameCapture& capture) {
   if (use_ != Use::kNone) return Status::Error("run session: run() on a session that has already run or stepped");
   use_ = Use::kRun;
@@ -104,19 +111,24 @@ Status RunSession::run(FrameCapture& capture) {
   // The trace is read only for `--profile` (keep_trace). Without it, reserving it would cost
   // 40 B x 8192 per stage that a long run fills and makes resident frame after frame.
   if (!options_.keep_trace) schedule.trace_capacity_per_stage = 0;
+  std::vector<runtime::Stage<OdometrySlot>*> stages{&extract_};
+  if (extract_odd_) stages.push_back(extract_odd_.get());
+  stages.push_back(&track_);
+  const int track_stage = int(stages.size());  // runner numbering: 0 = capture
+  stages.push_back(&map_);
   // Real time: mapping is off the latency path (poses are known when tracking is done), so under
   // contention the kernel serves capture, extract and track first. Nice 5, not more: the map stage
   // must still keep up on average, or the slots fill and frames drop. Not in fast mode, where every
   // stage is on the throughput path.
   if (isRealtime(schedule)) {
-    schedule.background_stages = 1u << 3;
+    schedule.background_stages = 1u << (track_stage + 1);
     schedule.background_nice = 5;
   }
   // End to end = sensor time to pose known (track done); the map stage refines later frames' map.
-  schedule.end_to_end_stage = 2;
+  schedule.end_to_end_stage = track_stage;
 
   CaptureStage capture_stage(capture, options_.max_frames, options_.stop, drops_);
-  runtime::StageRunner<OdometrySlot> runner(capture_stage, {&extract_, &track_, &map_}, schedule);
+  runtime::StageRunner<OdometrySlot> runner(capture_stage, stages, schedule);
   Status status = runner.run();
   const Status finished = finish();
   if (status.ok()) status = finished;
@@ -195,7 +207,7 @@ Status RunSession::finish() {
   }
   result_.frames = map_.frames();
   result_.frames_dropped = map_.framesDropped();
-  result_.extraction_failures = extract_.failures();
+  result_.extraction_failures = extractionFailures();
   result_.drops_without_trajectory_line = drops_.not_logged;
   const uint64_t counted = map_.framesAfterWarmup();
   result_.allocation_frames = counted > 0 ? counted - 1 : 0;

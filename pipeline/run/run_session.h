@@ -1,7 +1,7 @@
 #pragma once
 // RunSession: one odometry run's objects and its protocol, in one place. It owns the system, the
-// extract / track / map stages (pipeline/run/odometry_stages.h), the loop stage and the
-// MapperFence, and is driven one of two ways:
+// extract / track / map stages (pipeline/run/odometry_stages.h; threaded runs: two extract stages,
+// even and odd frames), the loop stage and the MapperFence, and is driven one of two ways:
 //
 //   run(capture)  the whole input through runtime::StageRunner in the options' schedule
 //                 (runOdometry(), pipeline/run/odometry_run.h: `plumb run`, tests, benchmarks);
@@ -63,7 +63,7 @@ class RunSession {
   OdometryRunResult takeResult() { return std::move(result_); }
   const OdometrySystem& system() const { return *system_; }
   uint64_t frames() const { return map_.frames(); }
-  uint64_t extractionFailures() const { return extract_.failures(); }
+  uint64_t extractionFailures() const;
 
  private:
   RunSession(std::unique_ptr<OdometrySystem> system, OdometrySink& sink, const OdometryRunOptions& options);
@@ -74,7 +74,8 @@ class RunSession {
   OdometrySink& sink_;
   DropLog drops_;
   MapperFence fence_;
-  ExtractStage extract_;
+  ExtractStage extract_;                        // every frame; threaded runs: the even ones
+  std::unique_ptr<ExtractStage> extract_odd_;   // threaded runs: the odd frames, on a thread of its own
   TrackStage track_;
   std::unique_ptr<LoopStage> loop_;  // before map_, which is given it; nullptr: loop closing off
   MapStage map_;
