@@ -50,7 +50,7 @@ RunOutputs::~RunOutputs() {
   if (frames_stream_ != nullptr) std::fclose(frames_stream_);
 }
 
-Status RunOutputs::open() {
+Status RunOutputs::begin(const OdometrySystem&) {
   if (!options_.optimized_path.empty()) {
     frames_stream_ = std::tmpfile();
     if (frames_stream_ == nullptr) return Status::Error("--out-optimized: cannot create a temporary file");
@@ -61,6 +61,7 @@ Status RunOutputs::open() {
     mavlink_ = std::make_unique<MavlinkOdometrySink>();
     PLUMB_RETURN_IF_ERROR(mavlink_->open(options_.mavlink).withContext("--mavlink"));
   }
+  opened_ = true;
   return Status::Ok();
 }
 
@@ -82,6 +83,7 @@ void RunOutputs::onPose(const FrameOutput& out) {
 
 Status RunOutputs::close(bool keep) {
   endProgress();
+  if (!opened_) return Status::Ok();
   if (!keep) {
     trajectory_writer_.abandon();
     covariance_writer_.abandon();
@@ -225,20 +227,17 @@ Status RunOutputs::onRetiredKeyframe(const RetiredKeyframe& kf) {
 
 Status runToOutputs(FrameSource& source, const SystemOptions& system_options, const OdometryRunOptions& run_options,
                     RunOutputs& outputs, RunRecord* record) {
-  std::unique_ptr<OdometrySystem> system;
-  PLUMB_RETURN_IF_ERROR(OdometrySystem::create(source.camera(), system_options, &system));
-  PLUMB_RETURN_IF_ERROR(outputs.open());
   SourceCapture capture(source);
-  const Status status = runOdometry(capture, *system, outputs, run_options, &record->run);
+  const Status status = runOdometry(capture, system_options, outputs, run_options, &record->run);
   // The outputs hold what was computed whatever ended the run, but a run that produced no frame
   // (it failed or was stopped before its first one) replaces no file: an older trajectory of that
   // name is worth more than an empty one.
   record->outputs_kept = record->run.frames + record->run.frames_dropped > 0;
   record->outputs_status = outputs.close(record->outputs_kept);
   if (record->outputs_kept && record->outputs_status.ok()) record->outputs_status = outputs.writeOptimized(record->run.loop);
-  record->odometry = system->stats();
-  record->mapper = system->mapperStats();
-  record->mapper_waits = system->mapperWaits();
+  record->odometry = record->run.odometry;
+  record->mapper = record->run.mapper;
+  record->mapper_waits = record->run.mapper_waits;
   return status.ok() ? record->outputs_status : status;
 }
 

@@ -46,9 +46,12 @@ class RunOutputs final : public OdometrySink {
   explicit RunOutputs(const RunOutputOptions& options);
   ~RunOutputs() override;
   static constexpr std::size_t kMaxReservedPoses = 108'000;  // an hour at 30 Hz
-  Status open();   // the files
+  // Opens the files; called by the run session once the run has been checked (a refused run
+  // opens none).
+  Status begin(const OdometrySystem&) override;
   // Flushes and closes them, under their names (keep) or not at all (abandon: the run produced
   // nothing valid, e.g. it failed before its first frame; an older file of that name stays).
+  // Nothing when they were never opened.
   Status close(bool keep = true);
   bool anyFile() const { return !options_.trajectory_path.empty() || !options_.covariance_path.empty() || !options_.optimized_path.empty(); }
   void endProgress();  // ends the terminal's progress line
@@ -74,6 +77,7 @@ class RunOutputs final : public OdometrySink {
   void progressLine(uint64_t frame, const FrameOutput& out);
 
   RunOutputOptions options_;
+  bool opened_ = false;
   TumTrajectoryWriter trajectory_writer_;
   CovarianceWriter covariance_writer_;
   std::vector<StampedPose> trajectory_;
@@ -106,9 +110,10 @@ struct RunRecord {
   Status outputs_status;
 };
 
-// Builds the system, runs it over `source` through the one runner into `outputs` (opened first,
-// closed after, also when the run failed: what was computed is kept; a run that produced no frame
-// replaces no file). The options were validated by the caller's plan (tools/run_plan.cpp).
+// Runs `source` through runOdometry() (pipeline/run/odometry_run.h: system, session, runner) into
+// `outputs` (opened when the run has been checked, closed after, also when the run failed: what
+// was computed is kept; a run that produced no frame replaces no file). The options were validated
+// by the caller's plan (tools/run_plan.cpp).
 Status runToOutputs(FrameSource& source, const SystemOptions& system_options, const OdometryRunOptions& run_options,
                     RunOutputs& outputs, RunRecord* record);
 

@@ -62,6 +62,12 @@ void Tracker::setLocalMap(const LocalMap& local_map) {
   if (has_last_frame_ && same_map) followMapCorrections();
 }
 
+void Tracker::adoptNewMap(const LocalMap& local_map) {
+  setLocalMap(local_map);
+  last_reference_id_ = local_map_->reference_keyframe_id;
+  T_world_last_reference_ = local_map_->T_world_reference;
+}
+
 void Tracker::reset() {
   state_ = TrackingState::kNotInitialized;
   has_last_frame_ = false;

@@ -49,6 +49,10 @@ class Tracker {
   // reference keyframe (or becomes the keyframe's refined pose when it was made one), its depth
   // points move with it, and its landmark associations take the landmarks' refined positions.
   void setLocalMap(const LocalMap& local_map);
+  // The map this tracker asked for (KeyframeRequest::start_new_map) at its last frame, built by
+  // the mapping side: installed like setLocalMap, and the last frame, which is that map's first
+  // keyframe, takes it as its reference (as resetAt would have, had the map been there already).
+  void adoptNewMap(const LocalMap& local_map);
   const LocalMap& localMap() const { return *local_map_; }
 
   // Tracks one frame. When the result asks for a keyframe, `request` has been filled.

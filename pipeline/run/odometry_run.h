@@ -1,6 +1,10 @@
 #pragma once
-// runOdometry(): THE frame loop of plumb. Every way of running the odometry (`plumb run`, `plumb
-// demo`, the system tests, the benchmarks, and every mode) goes through it:
+// runOdometry(): THE frame loop of plumb, and the one place a run is composed: capture -> system
+// -> RunSession (pipeline/run/run_session.h) -> runtime::StageRunner. Every way of running the
+// odometry over a source (`plumb run`, `plumb demo`, the API's runSource, the Python module's
+// run(), the system tests, the benchmarks, and every mode) calls it with its FrameCapture (a
+// FrameSource wrapped by drivers/common/source_capture.h); the push-style API steps the same
+// RunSession itself.
 //
 //   capture (FrameCapture: a sensor or replay, prepared ahead)
 //     -> extract (FeatureExtractor, own per stage)          pipeline/run/odometry_stages.h
@@ -13,17 +17,19 @@
 //   deterministic: lock-step on the calling thread, one frame through all stages before the next
 //     is read. This IS the single-threaded program: every frame sees exactly the map the previous
 //     frames left, so the output is byte-identical run after run.
-//   fast: a thread per stage over SPSC rings, capture and extract working ahead, but the tracker
-//     never runs past a keyframe it asked for (max_frames_ahead_of_mapper 0) and the loop stage
-//     runs on the map stage's thread: every frame is tracked against exactly the map lock-step
-//     would have, so the output is the deterministic output, byte for byte, however loaded the CPU
-//     (only the speed changes). Throughput comes from extraction overlapping track + map.
+//   fast: a thread per stage over SPSC rings, capture and extract working ahead; the map update a
+//     keyframe request of frame k asked for is used from frame k + SystemOptions::map_lag_frames on
+//     as in lock-step (the tracker waits there if the map stage is behind; max_frames_ahead_of_mapper
+//     0) and the loop stage runs on the map stage's thread: every frame is tracked against exactly
+//     the map lock-step would have, so the output is the deterministic output, byte for byte,
+//     however loaded the CPU (only the speed changes). Throughput comes from extraction
+//     overlapping track + map, and tracking overlapping the map stage for the lag's frames.
 //   realtime: a thread per stage; latency first: the tracker may run up to 4 frames past a pending
 //     keyframe on the newest published snapshot (timing dependent), the loop stage has its own
 //     thread. Paces the capture to the recorded timestamps and drops (and counts, and writes as
 //     `# <t> dropped`) a frame that finds no free slot.
 // The sink hears about every frame in frame order, on the map stage's thread. At the end (input
-// ended, max_frames, a stop request or an error) the system is finished: every pose held back for
+// ended, max_frames, a stop request or an error) the session is finished: every pose held back for
 // refinement is delivered to the sink, so a stop or a read error keeps what was computed.
 #include <atomic>
 #include <cstdint>
@@ -44,6 +50,10 @@ namespace plumb {
 class OdometrySink {
  public:
   virtual ~OdometrySink() = default;
+  // Once, when everything has been checked and built and before the first frame (open files here:
+  // a run refused for its options or camera leaves none). The system may be read from the map
+  // stage's callbacks (map counts, statistics).
+  virtual Status begin(const OdometrySystem&) { return Status::Ok(); }
   // The pose of a frame as soon as tracking has it, on the TRACK stage's thread, in frame order
   // (what a robot's controller wants, before mapping refines anything). Must not block: it is on
   // the latency path. Not called for dropped frames.
@@ -74,11 +84,12 @@ struct OdometryRunOptions {
   // on head250 and synth:repeated it accepts no loop (docs/LOOP.md "Measurements").
   bool loop_closing = true;
   loop::LoopCloserOptions loop;
-  // Threaded runs: frames the tracker may track past a keyframe it asked for before it waits for
-  // the map stage to publish it (bounded staleness, docs/RUNTIME.md "When the map stage falls
-  // behind"). -1 (default): by mode, 0 in fast (lock-step's map, the deterministic bytes) and
-  // kRealtimeFramesAhead in realtime (the tracker does not wait for a local BA; a lagging mapper
-  // backs up into the slot pool and frames drop, counted). Lock-step never waits.
+  // How tracking follows the map stage (docs/RUNTIME.md "When the map stage falls behind"). 0: at
+  // the fixed lag SystemOptions::map_lag_frames, lock-step's map, the deterministic bytes. > 0: the
+  // newest snapshot, tracking at most this many frames past a keyframe it asked for before it
+  // waits for the map stage to publish it (bounded staleness). -1 (default): by mode, 0 in
+  // deterministic and fast, kRealtimeFramesAhead in realtime (the tracker does not wait for a
+  // local BA; a lagging mapper backs up into the slot pool and frames drop, counted).
   int max_frames_ahead_of_mapper = -1;
   static constexpr int kRealtimeFramesAhead = 4;
   // Map files (docs/LOOP.md "Map files"). load_map: the run starts relocalizing into this map (its
@@ -96,7 +107,7 @@ struct OdometryRunOptions {
   }
 };
 
-// Empty Status when usable; otherwise what is wrong (checked by runOdometry before any work).
+// Empty Status when usable; otherwise what is wrong (checked by RunSession::create before any work).
 Status validate(const OdometryRunOptions& options);
 
 // What loop closing did in a run (loop_closing on).
@@ -130,9 +141,16 @@ struct OdometryRunResult {
   uint64_t allocation_frames = 0;
   uint64_t allocations_after_warmup = 0;
   double map_restore_ms = 0;  // load_map: loop closer + relocalizer filled (before the first frame)
+  // The system's counters at the end of the run.
+  OdometryStats odometry;
+  MapperStats mapper;
+  uint64_t mapper_waits = 0;  // threaded runs: times tracking waited for the map stage
 };
 
-Status runOdometry(FrameCapture& capture, OdometrySystem& system, OdometrySink& sink,
+// Builds the system for capture.camera() (options checked there and by validate()), runs every
+// frame of `capture` through it in options.schedule's mode into `sink`, and finishes the run
+// (RunSession). *result is filled also when the run failed part-way (what was computed).
+Status runOdometry(FrameCapture& capture, const SystemOptions& system_options, OdometrySink& sink,
                    const OdometryRunOptions& options, OdometryRunResult* result);
 
 }  // namespace plumb

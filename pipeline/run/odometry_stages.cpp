@@ -55,10 +55,16 @@ void CaptureStage::skip() {
 // ---------------------------------------------------------------------------------------------
 // ExtractStage, TrackStage
 
-ExtractStage::ExtractStage(const OdometrySystem& system)
-    : extractor_(system.camera(), system.options().odometry.extractor) {}
+ExtractStage::ExtractStage(const OdometrySystem& system, uint32_t stride, uint32_t offset)
+    : extractor_(system.camera(), system.options().odometry.extractor), stride_(stride), offset_(offset) {}
 
-Status ExtractStage::process(OdometrySlot& slot, const runtime::FrameStamps&) {
+const char* ExtractStage::name() const {
+  if (stride_ == 1) return "extract";
+  return offset_ == 0 ? "extract-even" : "extract-odd";
+}
+
+Status ExtractStage::process(OdometrySlot& slot, const runtime::FrameStamps& stamps) {
+  if (stamps.frame_index % stride_ != offset_) return Status::Ok();
   const auto start = std::chrono::steady_clock::now();
   // A frame that does not fit the camera is tracked featureless (and counted): it keeps its place.
   if (!extractor_.extract(slot.image, *slot.features)) {
@@ -81,15 +87,28 @@ Status TrackStage::process(OdometrySlot& slot, const runtime::FrameStamps&) {
 // ---------------------------------------------------------------------------------------------
 // MapStage
 
-Status MapStage::deliver(const FrameOutput& out) {
-  Status status = sink_.onFrame(out);
-  system_.drainFinishedFrames([&](const FinishedFrame& f) {
-    if (status.ok()) status = sink_.onFinishedFrame(f);
-  });
+void MapStage::drain(bool end_of_run, Status* status) {
+  system_.drainFinishedFrames(
+      [&](const FinishedFrame& f) {
+        if (status->ok()) *status = sink_.onFinishedFrame(f);
+      },
+      end_of_run);
+  if (end_of_run) system_.retireAllKeyframes();
   system_.drainRetiredKeyframes([&](const RetiredKeyframe& kf) {
     if (loop_ != nullptr) loop_->keyframeRetired(kf, system_.stats().loop_corrections_applied);
-    if (status.ok()) status = sink_.onRetiredKeyframe(kf);
+    if (status->ok()) *status = sink_.onRetiredKeyframe(kf);
   });
+}
+
+Status MapStage::deliver(const FrameOutput& out) {
+  Status status = sink_.onFrame(out);
+  drain(false, &status);
+  return status;
+}
+
+Status MapStage::deliverTheRest() {
+  Status status;
+  drain(true, &status);
   return status;
 }
 

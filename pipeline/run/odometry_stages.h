@@ -66,16 +66,22 @@ class CaptureStage final : public runtime::Source<OdometrySlot> {
   bool stopped_ = false;
 };
 
-// Stage 1: its own FeatureExtractor (extractors are one per thread), the system's camera and options.
+// Its own FeatureExtractor (extractors are one per thread), the system's camera and options. With
+// stride 2 two of them follow each other in the chain, one extracting the even frames and passing
+// the odd ones on, the other the reverse: the threaded modes extract two frames at once on two
+// threads without fan-out (extraction is a function of the frame alone, so the features, and the
+// bytes, are those of one extractor).
 class ExtractStage final : public runtime::Stage<OdometrySlot> {
  public:
-  explicit ExtractStage(const OdometrySystem& system);
-  const char* name() const override { return "extract"; }
-  Status process(OdometrySlot& slot, const runtime::FrameStamps&) override;
+  explicit ExtractStage(const OdometrySystem& system, uint32_t stride = 1, uint32_t offset = 0);
+  const char* name() const override;
+  // Frames whose runner index is offset modulo stride; the others pass through untouched.
+  Status process(OdometrySlot& slot, const runtime::FrameStamps& stamps) override;
   uint64_t failures() const { return failures_; }
 
  private:
   FeatureExtractor extractor_;
+  uint32_t stride_, offset_;
   uint64_t failures_ = 0;
 };
 
@@ -105,6 +111,9 @@ class MapStage final : public runtime::Stage<OdometrySlot> {
   // Frames dropped after the last processed one (the capture has finished).
   void finish() override;
   const Status& finishStatus() const { return finish_status_; }
+  // The end of a run, after finish() and the loop stage's last correction: every frame held back
+  // for refinement and then every keyframe reach the sink (and retired keyframes the loop stage).
+  Status deliverTheRest();
   uint64_t frames() const { return frames_; }
   uint64_t framesDropped() const { return frames_dropped_; }
   uint64_t framesAfterWarmup() const { return frames_after_warmup_; }
@@ -113,6 +122,9 @@ class MapStage final : public runtime::Stage<OdometrySlot> {
  private:
   Status writeDrops(uint32_t count);
   Status deliver(const FrameOutput& out);
+  // Finished frames, then retired keyframes, to the sink; a failure is kept in *status (the first
+  // one), after which the sink hears of nothing more.
+  void drain(bool end_of_run, Status* status);
 
   OdometrySystem& system_;
   MapperFence& fence_;
