@@ -19,7 +19,7 @@ ImagePyramid::ImagePyramid(int width, int height, int num_levels, float scale_fa
                         static_cast<int>(std::lround(height / scales_[i])));
     total_rows += sizes[i].height;
   }
-  row_filtered_.create(1, width + 6, CV_8UC1);  // one padded row
+  row_filtered_.create(1, width + 6, CV_16UC1);  // one padded row
   high_row_.create(1, width + 8, CV_16SC1);  // + padding: see downsample()
   low_row_.create(1, width + 8, CV_16SC1);
   high_row_.setTo(0);
@@ -35,6 +35,12 @@ ImagePyramid::ImagePyramid(int width, int height, int num_levels, float scale_fa
     CV_Assert(t.index1 == t.index0 + 1 || t.weight == 0);
     x_weight_pairs_.push_back(((1 << kWeightBits) - t.weight) | (t.weight << 16));
   }
+  const cv::Mat kernel = cv::getGaussianKernel(7, 2.0, CV_64F);
+  int sum = 0;
+  for (int k = 0; k < 7; ++k) sum += kernel_[k] = static_cast<int>(std::lround(kernel.at<double>(k) * 256));
+  kernel_[3] += 256 - sum;  // exact unit gain
+  // blur() relies on the symmetry (rounding symmetric weights keeps them symmetric).
+  CV_Assert(kernel_[0] == kernel_[6] && kernel_[1] == kernel_[5] && kernel_[2] == kernel_[4]);
   buffer_.create(total_rows, width, CV_8UC1);
   blurred_buffer_.create(total_rows, width, CV_8UC1);
   buffer_.setTo(0);
@@ -55,7 +61,7 @@ void ImagePyramid::build(const cv::Mat& grey) {
     // bilinear aliasing small.
     downsample(i);
   }
-  // The smoothing rotated BRIEF is defined on (blur() below).
+  // 7x7, sigma 2: the smoothing rotated BRIEF is defined on.
   for (int i = 0; i < num_levels_; ++i) blur(levels_[i], blurred_levels_[i]);
 }
 
@@ -142,77 +148,59 @@ void ImagePyramid::downsample(int level) {
   }
 }
 
-// The smoothing rotated BRIEF compares on: a 7-tap filter built from rounding byte averages,
-// avg(avg(c, p1), avg(p2, avg(p1, p3))) with p_i = avg(x - i, x + i), i.e. the triangle
-// (1, 2, 3, 4, 3, 2, 1) / 16 before rounding (variance 2.5 px^2, sigma 1.58; the 7-tap Gaussian of
-// sigma 2 it replaces has an effective sigma of 1.64 after truncation). Six byte averages per 16
-// pixels and pass, where the 16-bit fixed-point Gaussian took ~7 instructions a pixel (a fifth of
-// ORB). Each average rounds up (pavgb / urhadd), which shifts the whole image by at most a grey
-// level and a half: BRIEF's pixel comparisons do not see a common offset. Vertical pass into a
-// padded byte row, then horizontal; reflected borders (BORDER_REFLECT_101).
-namespace {
-
-// The filter on seven bytes / vectors at offsets -3..3 (a[0] .. a[6]).
-template <typename T, typename Avg>
-inline T triangleTree(const T& m3, const T& m2, const T& m1, const T& c, const T& p1, const T& p2, const T& p3,
-                      Avg avg) {
-  const T a1 = avg(m1, p1), a2 = avg(m2, p2), a3 = avg(m3, p3);
-  return avg(avg(c, a1), avg(a2, avg(a1, a3)));
-}
-
-inline uint8_t averageUp(uint8_t a, uint8_t b) { return static_cast<uint8_t>((a + b + 1) >> 1); }
-
-// (a + b + 1) >> 1 per byte: one instruction on both targets (OpenCV 4.6's universal intrinsics
-// have no byte average, so the two native ones are named here).
-inline cv::v_uint8x16 averageUp(const cv::v_uint8x16& a, const cv::v_uint8x16& b) {
-#if CV_SSE2
-  return cv::v_uint8x16(_mm_avg_epu8(a.val, b.val));
-#elif CV_NEON
-  return cv::v_uint8x16(vrhaddq_u8(a.val, b.val));
-#else
-  uint8_t x[16], y[16];
-  cv::v_store(x, a);
-  cv::v_store(y, b);
-  for (int i = 0; i < 16; ++i) x[i] = averageUp(x[i], y[i]);
-  return cv::v_load(x);
-#endif
-}
-
-}  // namespace
-
-uint8_t ImagePyramid::blurTap(uint8_t m3, uint8_t m2, uint8_t m1, uint8_t c, uint8_t p1, uint8_t p2, uint8_t p3) {
-  return triangleTree(m3, m2, m1, c, p1, p2, p3, [](uint8_t a, uint8_t b) { return averageUp(a, b); });
-}
-
 void ImagePyramid::blur(const cv::Mat& src, cv::Mat& dst) {
+  // Separable, vertical pass first, 8.8 fixed point: the vertical sum (<= 255 * 256) is rounded
+  // back to 8 bits of range so the horizontal pass also fits 16-bit lanes (the lost fraction is far
+  // below what the binary tests can see). One padded 16-bit row buffer, reflected borders.
   const int w = src.cols, h = src.rows;
   auto reflect = [](int i, int n) { return i < 0 ? -i : (i >= n ? 2 * n - 2 - i : i); };  // REFLECT_101
-  auto vavg = [](const cv::v_uint8x16& a, const cv::v_uint8x16& b) { return averageUp(a, b); };
-  uint8_t* t = row_filtered_.ptr<uint8_t>(0) + 3;  // t[-3 .. w+2] valid after padding
+  uint16_t* t = row_filtered_.ptr<uint16_t>(0) + 3;  // t[-3 .. w+2] valid after padding
+  const uint16_t k[7] = {uint16_t(kernel_[0]), uint16_t(kernel_[1]), uint16_t(kernel_[2]), uint16_t(kernel_[3]),
+                         uint16_t(kernel_[4]), uint16_t(kernel_[5]), uint16_t(kernel_[6])};
+  cv::v_uint16x8 vk[7];
+  for (int i = 0; i < 7; ++i) vk[i] = cv::v_setall_u16(k[i]);
+  const cv::v_uint16x8 half = cv::v_setall_u16(128);
   for (int y = 0; y < h; ++y) {
     const uint8_t* r[7];
     for (int i = 0; i < 7; ++i) r[i] = src.ptr<uint8_t>(reflect(y + i - 3, h));
     int x = 0;
+    // The kernel is symmetric: rows 3 - i and 3 + i are added first (<= 510) and multiplied
+    // once, 4 multiplies instead of 7 for the same integer sum (<= 65280: no overflow).
     for (; x + 16 <= w; x += 16) {
-      cv::v_store(t + x, triangleTree(cv::v_load(r[0] + x), cv::v_load(r[1] + x), cv::v_load(r[2] + x),
-                                      cv::v_load(r[3] + x), cv::v_load(r[4] + x), cv::v_load(r[5] + x),
-                                      cv::v_load(r[6] + x), vavg));
+      cv::v_uint16x8 lo, hi, a, b;
+      cv::v_expand(cv::v_load(r[3] + x), lo, hi);
+      lo = cv::v_mul_wrap(lo, vk[3]);
+      hi = cv::v_mul_wrap(hi, vk[3]);
+      for (int i = 0; i < 3; ++i) {
+        cv::v_uint16x8 c, e;
+        cv::v_expand(cv::v_load(r[i] + x), a, b);
+        cv::v_expand(cv::v_load(r[6 - i] + x), c, e);
+        lo += cv::v_mul_wrap(a + c, vk[i]);
+        hi += cv::v_mul_wrap(b + e, vk[i]);
+      }
+      cv::v_store(t + x, (lo + half) >> 8);
+      cv::v_store(t + x + 8, (hi + half) >> 8);
     }
-    for (; x < w; ++x) t[x] = blurTap(r[0][x], r[1][x], r[2][x], r[3][x], r[4][x], r[5][x], r[6][x]);
+    for (; x < w; ++x) {
+      unsigned acc = 0;
+      for (int i = 0; i < 7; ++i) acc += k[i] * r[i][x];
+      t[x] = static_cast<uint16_t>((acc + 128) >> 8);
+    }
     for (int i = 1; i <= 3; ++i) {
       t[-i] = t[reflect(-i, w)];
       t[w - 1 + i] = t[reflect(w - 1 + i, w)];
     }
     uint8_t* d = dst.ptr<uint8_t>(y);
     x = 0;
-    for (; x + 16 <= w; x += 16) {
-      const uint8_t* q = t + x;
-      cv::v_store(d + x, triangleTree(cv::v_load(q - 3), cv::v_load(q - 2), cv::v_load(q - 1), cv::v_load(q),
-                                      cv::v_load(q + 1), cv::v_load(q + 2), cv::v_load(q + 3), vavg));
+    for (; x + 8 <= w; x += 8) {
+      cv::v_uint16x8 acc = cv::v_mul_wrap(cv::v_load(t + x), vk[3]);
+      for (int i = 0; i < 3; ++i) acc += cv::v_mul_wrap(cv::v_load(t + x + i - 3) + cv::v_load(t + x + 3 - i), vk[i]);
+      cv::v_pack_store(d + x, (acc + half) >> 8);
     }
     for (; x < w; ++x) {
-      const uint8_t* q = t + x;
-      d[x] = blurTap(q[-3], q[-2], q[-1], q[0], q[1], q[2], q[3]);
+      unsigned acc = 0;
+      for (int i = 0; i < 7; ++i) acc += k[i] * t[x + i - 3];
+      d[x] = static_cast<uint8_t>((acc + 128) >> 8);
     }
   }
 }

@@ -2,9 +2,8 @@
 // ImagePyramid: the grey image at num_levels scales (level i is 1/scale^i of level 0) plus a
 // Gaussian-blurred copy of every level for the binary descriptors.
 //
-// Allocation: build() allocates nothing. The blur is our own separable filter of byte averages,
-// close to a Gaussian of sigma 1.6 (cv::GaussianBlur builds a filter engine, ~10 heap allocations
-// per call) and so is the bilinear downsampler
+// Allocation: build() allocates nothing. The blur is our own separable filter (cv::GaussianBlur
+// builds a filter engine, ~10 heap allocations per call) and so is the bilinear downsampler
 // (cv::resize allocates 2-3 small buffers per call); its sampling tables are built once here.
 //
 // All levels live as ROIs of ONE buffer whose row stride is level 0's width, so a pixel offset
@@ -31,9 +30,6 @@ class ImagePyramid {
   const cv::Mat& level(int i) const { return levels_[i]; }
   const cv::Mat& blurred(int i) const { return blurred_levels_[i]; }
   int stride() const { return static_cast<int>(buffer_.step[0]); }  // bytes per row, every level
-  // The blur's filter on the seven pixels at -3..3 along one axis (blur() applies it vertically,
-  // then horizontally; exposed for the scalar oracle of the tests).
-  static uint8_t blurTap(uint8_t m3, uint8_t m2, uint8_t m1, uint8_t c, uint8_t p1, uint8_t p2, uint8_t p3);
 
  private:
   int num_levels_;
@@ -56,7 +52,8 @@ class ImagePyramid {
   cv::Mat high_row_, low_row_;      // CV_16SC1, one source row + padding: the vertical pass, split
 
   cv::Mat buffer_, blurred_buffer_;
-  cv::Mat row_filtered_;            // CV_8UC1, one row + 3 px padding each side: the blur's vertical pass
+  cv::Mat row_filtered_;            // CV_16UC1, one row + 3 px padding each side: the blur's vertical pass
+  std::array<int, 7> kernel_{};     // 7-tap Gaussian, sigma 2, fixed point (sum 256)
   std::array<cv::Mat, kPyramidLevels> levels_, blurred_levels_;
 };
 

@@ -1,5 +1,5 @@
 // The vectorised front-end kernels against plain scalar oracles written from their definitions:
-// the pyramid (bilinear 1.2 steps, then the 7-tap byte-average blur), the intensity-centroid
+// the pyramid (bilinear 1.2 steps, then the 7-tap fixed-point blur), the intensity-centroid
 // orientation and the LBD-style line descriptor. The fast versions claim to compute exactly the
 // same integers and floats, so the comparisons are for equality, not tolerance.
 #include <algorithm>
@@ -65,60 +65,31 @@ cv::Mat referenceDownsample(const cv::Mat& src, cv::Size size) {
   return dst;
 }
 
-// The blur's definition: ImagePyramid::blurTap (a tree of rounding byte averages, weights
-// (1, 2, 3, 4, 3, 2, 1) / 16) down every column, then along every row of that result, reflected
-// borders (BORDER_REFLECT_101).
+// 7-tap Gaussian (sigma 2) in 8.8 fixed point, vertical then horizontal, each pass rounded,
+// reflected borders (BORDER_REFLECT_101).
 cv::Mat referenceBlur(const cv::Mat& src) {
+  const cv::Mat g = cv::getGaussianKernel(7, 2.0, CV_64F);
+  int k[7], sum = 0;
+  for (int i = 0; i < 7; ++i) sum += k[i] = static_cast<int>(std::lround(g.at<double>(i) * 256));
+  k[3] += 256 - sum;
   auto reflect = [](int i, int n) { return i < 0 ? -i : (i >= n ? 2 * n - 2 - i : i); };
-  auto tap = [](const uint8_t* v) { return ImagePyramid::blurTap(v[0], v[1], v[2], v[3], v[4], v[5], v[6]); };
-  cv::Mat vertical(src.size(), CV_8UC1), dst(src.size(), CV_8UC1);
-  uint8_t v[7];
+  cv::Mat vertical(src.size(), CV_32SC1), dst(src.size(), CV_8UC1);
   for (int y = 0; y < src.rows; ++y)
     for (int x = 0; x < src.cols; ++x) {
-      for (int i = 0; i < 7; ++i) v[i] = src.at<uint8_t>(reflect(y + i - 3, src.rows), x);
-      vertical.at<uint8_t>(y, x) = tap(v);
+      int acc = 0;
+      for (int i = 0; i < 7; ++i) acc += k[i] * src.at<uint8_t>(reflect(y + i - 3, src.rows), x);
+      vertical.at<int>(y, x) = (acc + 128) >> 8;
     }
   for (int y = 0; y < src.rows; ++y)
     for (int x = 0; x < src.cols; ++x) {
-      for (int i = 0; i < 7; ++i) v[i] = vertical.at<uint8_t>(y, reflect(x + i - 3, src.cols));
-      dst.at<uint8_t>(y, x) = tap(v);
+      int acc = 0;
+      for (int i = 0; i < 7; ++i) acc += k[i] * vertical.at<int>(y, reflect(x + i - 3, src.cols));
+      dst.at<uint8_t>(y, x) = static_cast<uint8_t>((acc + 128) >> 8);
     }
   return dst;
 }
 
-// blurTap against its weights: within 1.5 grey levels of (1, 2, 3, 4, 3, 2, 1) / 16 (each of the
-// tree's averages rounds up by at most half a level), and exact on constants.
-TEST(FrontendKernels, BlurTapIsTheRoundedTriangleFilter) {
-  cv::RNG rng(17);
-  const int weights[7] = {1, 2, 3, 4, 3, 2, 1};
-  for (int n = 0; n < 20000; ++n) {
-    uint8_t v[7];
-    int sum = 0;
-    for (int i = 0; i < 7; ++i) sum += weights[i] * (v[i] = static_cast<uint8_t>(rng.uniform(0, 256)));
-    const double exact = sum / 16.0;
-    const int got = ImagePyramid::blurTap(v[0], v[1], v[2], v[3], v[4], v[5], v[6]);
-    ASSERT_GE(got, exact - 1e-9) << n;
-    ASSERT_LE(got, exact + 1.5) << n;
-  }
-  for (int c = 0; c < 256; ++c) {
-    const uint8_t b = static_cast<uint8_t>(c);
-    ASSERT_EQ(ImagePyramid::blurTap(b, b, b, b, b, b, b), c);
-  }
-}
-
-// The BRIEF smoothing stays close to the 7x7 Gaussian of sigma 2 that ORB is defined with.
-TEST(FrontendKernels, BlurIsCloseToTheSigma2Gaussian) {
-  const cv::Mat img = testImage(643, 481, 12);
-  ImagePyramid pyramid(img.cols, img.rows, 1, 1.2f);
-  pyramid.build(img);
-  cv::Mat gaussian, difference;
-  cv::GaussianBlur(img, gaussian, cv::Size(7, 7), 2.0, 2.0, cv::BORDER_REFLECT_101);
-  cv::absdiff(pyramid.blurred(0), gaussian, difference);
-  EXPECT_LT(cv::mean(difference)[0], 1.5);
-  EXPECT_LE(cv::norm(difference, cv::NORM_INF), 12);
-}
-
-TEST(FrontendKernels, PyramidEqualsExactBilinearAndByteAverageBlur) {
+TEST(FrontendKernels, PyramidEqualsExactBilinearAndFixedPointBlur) {
   const cv::Mat img = testImage(643, 481, 11);
   ImagePyramid pyramid(img.cols, img.rows, 8, 1.2f);
   pyramid.build(img);
