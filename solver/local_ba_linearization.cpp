@@ -128,9 +128,10 @@ double LocalBundleAdjuster::linearize(const LocalBaOptions& options) {
           Eigen::Vector3d e;
           Eigen::Matrix3d J_cam;
           stereoResidualAt(camera_, P_cam, obs.z, &e, &J_cam);
-          obs.chi2 = e.dot(obs.information * e);
+          const Eigen::Vector3d omega_e = obs.information * e;
+          obs.chi2 = e.dot(omega_e);
           k = evaluateKernel(kernel, obs.chi2);
-          pointSpaceBlocks<3>(J_cam, k.rho1 * obs.information, e, &M, &q);
+          stereoPointSpaceBlocks(J_cam, obs.information, omega_e, k.rho1, &M, &q);
           break;
         }
         case ObservationKind::kMonoPoint: {

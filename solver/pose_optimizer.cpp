@@ -81,9 +81,10 @@ NormalEquations linearize(const CameraIntrinsics& camera, const Eigen::Isometry3
       Eigen::Vector3d e;
       Eigen::Matrix3d J_cam;
       stereoResidualAt(camera, P_cam, obs.z, &e, &J_cam);
+      const Eigen::Vector3d omega_e = obs.information * e;
       double rho = 0.0, weight = 0.0;
-      robustCostAndWeight(kernels.stereo, e.dot(obs.information * e), &rho, &weight);
-      pointSpaceBlocks<3>(J_cam, weight * obs.information, e, &M, &q);
+      robustCostAndWeight(kernels.stereo, e.dot(omega_e), &rho, &weight);
+      stereoPointSpaceBlocks(J_cam, obs.information, omega_e, weight, &M, &q);
       ne.cost += 0.5 * rho;
     } else {
       Eigen::Vector2d e;
