@@ -220,7 +220,7 @@ bool LocalBundleAdjuster::solveDamped(const LocalBaOptions& options, double lamb
     for (int a = 0; a < num_free; ++a) {
       const Observation& obs_a = observations_[free_obs[a]];
       const int v_a = keyframes_[obs_a.keyframe].variable;
-      subtractVWt(obs_a.V, obs_a.W, block(v_a, v_a), stride);
+      subtractVWtLower(obs_a.V, obs_a.W, block(v_a, v_a), stride);
       for (int b = a + 1; b < num_free; ++b) {
         const Observation& obs_b = observations_[free_obs[b]];
         const int v_b = keyframes_[obs_b.keyframe].variable;

@@ -47,6 +47,24 @@ inline void subtractVWt(const Matrix63d& V, const Matrix63d& W, double* S, Eigen
   }
 }
 
+// The same on a diagonal block, lower triangle only (all the Cholesky of S reads): column c gets
+// the row pairs from (c & ~1) down, 12 of the 18 pairs. The entries it writes are computed exactly
+// as subtractVWt computes them, so the factor and everything after it are bit-identical.
+inline void subtractVWtLower(const Matrix63d& V, const Matrix63d& W, double* S, Eigen::Index stride) {
+  using namespace schur_detail;
+  const double* v = V.data();
+  const Double2 v00 = load2(v), v01 = load2(v + 2), v02 = load2(v + 4);
+  const Double2 v10 = load2(v + 6), v11 = load2(v + 8), v12 = load2(v + 10);
+  const Double2 v20 = load2(v + 12), v21 = load2(v + 14), v22 = load2(v + 16);
+  const double* w = W.data();
+  for (int c = 0; c < 6; ++c, S += stride) {
+    const Double2 w0 = splat(w[c]), w1 = splat(w[6 + c]), w2 = splat(w[12 + c]);
+    if (c < 2) store2(S, load2(S) - (v00 * w0 + v10 * w1 + v20 * w2));
+    if (c < 4) store2(S + 2, load2(S + 2) - (v01 * w0 + v11 * w1 + v21 * w2));
+    store2(S + 4, load2(S + 4) - (v02 * w0 + v12 * w1 + v22 * w2));
+  }
+}
+
 // V = W H (W 6x3, H 3x3) and rhs += V g (rhs: 6 doubles).
 inline void formVAndRhs(const Matrix63d& W, const Eigen::Matrix3d& H, const Eigen::Vector3d& g, Matrix63d* V,
                         double* rhs) {

@@ -1,8 +1,9 @@
 // The fast paths of the solvers' inner loops against straightforward Eigen references written
 // from their definitions: the stereo point-space blocks (solver/point_space_blocks.h), the pose
-// block lifted from them, and the two 6x6 / 6x3 kernels of the landmark elimination
-// (solver/schur_kernels.h). They compute the same sums in another order, so the comparisons are
-// to a relative 1e-12, which any wrong index or sign misses by far.
+// block lifted from them, and the small kernels of the landmark elimination
+// (solver/schur_kernels.h; its diagonal-block variant writes the lower triangle only). They
+// compute the same sums in another order, so the comparisons are to a relative 1e-12, which any
+// wrong index or sign misses by far.
 #include <random>
 
 #include <gtest/gtest.h>
@@ -106,6 +107,20 @@ TEST(SolverKernels, SchurBlockKernelsEqualEigenProducts) {
     Eigen::MatrixXd outside = S - before;
     outside.block<6, 6>(3, 5).setZero();
     ASSERT_EQ(outside.cwiseAbs().maxCoeff(), 0.0) << n;
+
+    // The diagonal-block variant: the lower triangle bit-identical to the full kernel's, the
+    // strict upper triangle beyond the 2x2 pairs on the diagonal untouched.
+    Eigen::MatrixXd lower = before;
+    subtractVWtLower(V_in, W, &lower(3, 5), lower.outerStride());
+    for (int c = 0; c < 6; ++c) {
+      for (int r = 0; r < 6; ++r) {
+        if (r >= c) {
+          ASSERT_EQ(lower(3 + r, 5 + c), S(3 + r, 5 + c)) << n << " " << r << " " << c;
+        } else if (r < (c & ~1)) {
+          ASSERT_EQ(lower(3 + r, 5 + c), before(3 + r, 5 + c)) << n << " " << r << " " << c;
+        }
+      }
+    }
   }
 }
 
