@@ -27,6 +27,7 @@ TEST_PACKAGES=(
   libgtest-dev libbenchmark-dev
   python3-dev python3-pybind11 pybind11-dev python3-numpy python3-pytest
   valgrind  # ctest instruction_budget (bench/instructions/; skipped without it)
+  libceres-dev  # plumb_bench_solver's and plumb_test_solver_ceres's oracle (never linked by the product)
   clang libclang-rt-14-dev  # fuzz targets (scripts/fuzz.sh): libFuzzer is in libclang-rt-14-dev
   nodejs npm  # the independent MAVLink decoder of tests/mavlink_node (node-mavlink, pinned)
 )

@@ -63,6 +63,7 @@
 #include <Eigen/Core>
 
 #include "solver/outlier_thresholds.h"
+#include "solver/point_space_blocks.h"
 #include "solver/camera_intrinsics.h"
 #include "solver/robust_kernel.h"
 #include "solver/types.h"
@@ -179,6 +180,7 @@ class LocalBundleAdjuster {
     Matrix6d H_pose = Matrix6d::Zero();  // undamped diagonal block of H_pp
     Vector6d g_pose = Vector6d::Zero();
     Vector6d step = Vector6d::Zero();
+    PoseNormalAccumulator normal;  // H_pose / g_pose as they are summed (free keyframes)
     int variable = -1;  // index into the reduced system; -1 when fixed
   };
   struct Landmark {

@@ -15,6 +15,7 @@ LocalMapper::LocalMapper(const PinholeCamera& camera, const OdometryOptions& opt
   intrinsics_ = CameraIntrinsics{camera.fx, camera.fy, camera.cx, camera.cy, camera.fx * camera.baseline_m};
   const LocalMapperOptions& m = options.mapper;
   ba_options_.max_iterations = m.ba_iterations;
+  ba_options_.function_tolerance = m.ba_function_tolerance;
   ba_options_.chi2 = m.chi2;
   const int max_keyframes = m.ba_optimised_keyframes + m.ba_fixed_keyframes;
   const int max_observations = m.max_ba_landmarks * 8;

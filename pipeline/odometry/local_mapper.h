@@ -100,6 +100,8 @@ class LocalMapper {
   // local_mapper_ba.cpp
   void runLocalBa(int kf_slot, InsertResult* result);
   void selectWindow(int kf_slot);
+  void excludeSingleViewLandmarks();
+  void moveSingleViewLandmarks();
   // local_mapper_snapshot.cpp
   void publishSnapshot(int kf_slot);
   void rankCovisible(int kf_slot, int count, FixedVector<int, kMaxMapKeyframes>* out) const;
@@ -129,6 +131,11 @@ class LocalMapper {
     std::array<int, kMaxMapKeyframes> ba_keyframe_index{};  // slot -> BA keyframe index
     FixedVector<uint32_t, kMaxMapPoints> ba_points;   // BA landmark order: point slots ...
     FixedVector<uint32_t, kMaxMapLines> ba_lines;     // ... then line slots (samples consecutive)
+    // Landmarks of the window seen by one BA keyframe only: left out of the BA and moved
+    // rigidly with that keyframe afterwards (local_mapper_ba.cpp, excludeSingleViewLandmarks).
+    FixedVector<uint32_t, kMaxMapPoints> single_view_points;
+    FixedVector<uint32_t, kMaxMapLines> single_view_lines;
+    std::array<Eigen::Isometry3d, kMaxMapKeyframes> ba_correction;  // T_world_cam new * old^-1
     FixedVector<std::pair<float, uint16_t>, kMaxKeypoints> new_point_order;
     FixedVector<std::pair<float, uint32_t>, kMaxMapPoints> retire_order;
   };

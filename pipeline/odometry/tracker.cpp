@@ -41,6 +41,7 @@ Tracker::Tracker(const PinholeCamera& camera, const OdometryOptions& options)
   pose_options_.chi2 = options.tracker.chi2;
   pose_options_.rounds = options.tracker.pose_rounds;
   pose_options_.iterations_per_round = options.tracker.pose_iterations_per_round;
+  pose_options_.step_tolerance = options.tracker.pose_step_tolerance;
   local_map_ = &b_->local_map;
   local_map_->clear();
 }
