@@ -10,9 +10,12 @@
 // (undistortPoint) and everything downstream (matching by projection, the solver) works in the
 // ideal pinhole model.
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include <Eigen/Core>
+
+#include "sensor/depth_camera.h"
 
 namespace plumb {
 
@@ -32,6 +35,16 @@ struct PinholeCamera {
   // Rolling shutter: seconds from the first to the last image row's exposure; 0 = global shutter.
   // The tracker moves features to the middle row's time (pipeline/odometry/tracker_rolling_shutter.h).
   double rolling_shutter_readout_s = 0.0;
+  // Depth from a separate depth camera, not registered to this (colour) camera: its intrinsics,
+  // size and T_colour_depth. Empty (every preset): depth images are registered, camera-sized.
+  // Sources deliver such depth as the depth camera sees it (depthWidth() x depthHeight()); the
+  // pipeline registers it into this camera before extraction (docs/FRONTEND.md).
+  std::optional<DepthCamera> depth_camera;
+
+  bool depthRegistered() const { return !depth_camera.has_value(); }
+  // Size of the depth images a source delivers.
+  int depthWidth() const { return depth_camera ? depth_camera->width : width; }
+  int depthHeight() const { return depth_camera ? depth_camera->height : height; }
 
   bool hasDistortion() const { return k1 != 0 || k2 != 0 || p1 != 0 || p2 != 0 || k3 != 0; }
 
@@ -92,8 +105,46 @@ struct PinholeCamera {
     if (!finite(baseline_m) || baseline_m <= 0) return "baseline must be positive";
     if (!finite(rolling_shutter_readout_s) || rolling_shutter_readout_s < 0)
       return "rolling_shutter_readout must be >= 0";
+    if (depth_camera) return validateDepthCamera();
+    return "";
+  }
+
+ private:
+  // The depth camera on its own (depth_camera.h), then one joint check: the centre of the depth
+  // camera's view at 2 m must land in the colour image, or the transform points the wrong way
+  // (colour-to-depth given for depth-to-colour) or belongs to another camera.
+  std::string validateDepthCamera() const {
+    const std::string problem = depth_camera->validate(kMaxImageSide);
+    if (!problem.empty()) return problem;
+    const DepthCamera& d = *depth_camera;
+    const Eigen::Vector3d P_depth((d.width / 2.0 - d.cx) / d.fx * 2.0, (d.height / 2.0 - d.cy) / d.fy * 2.0, 2.0);
+    const Eigen::Vector3d P_colour = d.T_colour_depth() * P_depth;
+    const Eigen::Vector2d px = P_colour.z() > 0 ? project(P_colour) : Eigen::Vector2d(-1e9, -1e9);
+    if (!inImage(px.x(), px.y())) {
+      return "the centre of the depth camera's view (at 2 m) falls outside the colour image, at (" +
+             std::to_string(px.x()) + ", " + std::to_string(px.y()) +
+             "): is depth_to_colour the colour-to-depth transform, or another camera's?";
+    }
     return "";
   }
 };
+
+// The lens of a depth camera alone (intrinsics, distortion, size) as a PinholeCamera, for its
+// projection and undistortion; the other fields keep their defaults.
+inline PinholeCamera depthCameraLens(const DepthCamera& d) {
+  PinholeCamera lens;
+  lens.fx = d.fx;
+  lens.fy = d.fy;
+  lens.cx = d.cx;
+  lens.cy = d.cy;
+  lens.k1 = d.k1;
+  lens.k2 = d.k2;
+  lens.p1 = d.p1;
+  lens.p2 = d.p2;
+  lens.k3 = d.k3;
+  lens.width = d.width;
+  lens.height = d.height;
+  return lens;
+}
 
 }  // namespace plumb

@@ -17,6 +17,12 @@ Status RecordingWriter::open(const std::string& path, const PinholeCamera& camer
                              std::unique_ptr<RecordingWriter>* out) {
   const std::string problem = camera.validate();
   if (!problem.empty()) return Status::Error(path + ": camera invalid: " + problem);
+  // The format's header has no place for a separate depth camera: writing such frames would turn
+  // unregistered depth into "registered" depth on replay, a silently wrong answer.
+  if (!camera.depthRegistered())
+    return Status::Error(path + ": the camera's depth is not registered to colour (it describes a depth camera); "
+                                "recordings (format version 2) hold registered depth only. Replay the source "
+                                "directly, or register the depth first");
   if (options.png_compression < 0 || options.png_compression > 9)
     return Status::Error(path + ": png_compression must be 0..9");
   std::unique_ptr<RecordingWriter> writer(new RecordingWriter());

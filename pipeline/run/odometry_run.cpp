@@ -61,12 +61,17 @@ Status runOdometry(FrameCapture& capture, OdometrySystem& system, OdometrySink& 
   // contention the kernel serves capture, extract and track first. Nice 5, not more: the map stage
   // must still keep up on average, or the slots fill and frames drop. Not in fast mode, where every
   // stage is on the throughput path.
+  // A camera whose depth is not registered to colour gets a register stage before extraction
+  // (its own thread in the threaded modes, its own trace track and report row); others run
+  // without it, exactly as before it existed.
+  RegisterStage register_stage(system.camera());
+  const int first_stage = register_stage.needed() ? 2 : 1;  // index of the extract stage
   if (schedule.mode == runtime::RunMode::kRealtime) {
-    schedule.background_stages = 1u << 3;
+    schedule.background_stages = 1u << (first_stage + 2);  // the map stage
     schedule.background_nice = 5;
   }
   // End to end = sensor time to pose known (track done); the map stage refines later frames' map.
-  schedule.end_to_end_stage = 2;
+  schedule.end_to_end_stage = first_stage + 1;
 
   DropLog drops;
   const bool realtime = schedule.mode == runtime::RunMode::kRealtime;
@@ -110,7 +115,16 @@ Status runOdometry(FrameCapture& capture, OdometrySystem& system, OdometrySink& 
   }
   if (loop) loop->start();
   MapStage map(system, fence, drops, sink, options.warmup_frames, loop.get());
-  runtime::StageRunner<OdometrySlot> runner(capture_stage, {&extract, &track, &map}, schedule);
+  std::vector<runtime::Stage<OdometrySlot>*> stages = {&extract, &track, &map};
+  if (register_stage.needed()) stages.insert(stages.begin(), &register_stage);
+  runtime::StageRunner<OdometrySlot> runner(capture_stage, stages, schedule);
+  // Registered-depth buffers sized once, with the pool (registerInto() then never allocates).
+  if (register_stage.needed()) {
+    const PinholeCamera& camera = system.camera();
+    for (std::size_t i = 0; i < runner.pool().size(); ++i) {
+      runner.pool()[runtime::SlotIndex(i)].payload.registered_depth.create(camera.height, camera.width, CV_16UC1);
+    }
+  }
   Status status = runner.run();
   if (status.ok()) status = map.finishStatus();
   if (loop) {
@@ -157,7 +171,7 @@ Status runOdometry(FrameCapture& capture, OdometrySystem& system, OdometrySink& 
   if (options.keep_trace) result->trace = runner.trace();
   result->frames = map.frames();
   result->frames_dropped = map.framesDropped();
-  result->extraction_failures = extract.failures();
+  result->extraction_failures = extract.failures() + register_stage.failures();
   result->drops_without_trajectory_line = drops.not_logged;
   result->stopped = capture_stage.stopped();
   const uint64_t counted = map.framesAfterWarmup();

@@ -8,6 +8,7 @@ OdometryStepper::OdometryStepper(OdometrySystem& system, OdometrySink& sink,
                                  const loop::LoopCloserOptions* loop_options)
     : system_(system),
       sink_(sink),
+      register_(system.camera()),
       extract_(system),
       track_(system, fence_, sink),
       loop_(loop_options != nullptr ? std::make_unique<LoopStage>(system, *loop_options, false, 0) : nullptr),
@@ -17,7 +18,8 @@ OdometryStepper::OdometryStepper(OdometrySystem& system, OdometrySink& sink,
   if (loop_) loop_->start();
   const PinholeCamera& camera = system.camera();
   slot_.image.bgr.create(camera.height, camera.width, CV_8UC3);
-  slot_.image.depth_raw.create(camera.height, camera.width, CV_16UC1);
+  slot_.image.depth_raw.create(camera.depthHeight(), camera.depthWidth(), CV_16UC1);
+  if (register_.needed()) slot_.registered_depth.create(camera.height, camera.width, CV_16UC1);
   slot_.image.depth_factor = camera.depth_factor;
 }
 
@@ -30,6 +32,7 @@ Status OdometryStepper::step() {
   slot_.dropped_before = 0;
   ++frames_;
   // The runner's lock-step order (runtime::StageRunner in deterministic mode).
+  if (register_.needed()) PLUMB_RETURN_IF_ERROR(register_.process(slot_, stamps));
   PLUMB_RETURN_IF_ERROR(extract_.process(slot_, stamps));
   PLUMB_RETURN_IF_ERROR(track_.process(slot_, stamps));
   PLUMB_RETURN_IF_ERROR(map_.process(slot_, stamps));

@@ -35,8 +35,9 @@ class OdometryStepper {
   OdometryStepper(OdometrySystem& system, OdometrySink& sink, const loop::LoopCloserOptions* loop_options = nullptr);
   ~OdometryStepper();
 
-  // The frame to fill before step(): write bgr (CV_8UC3, camera size), depth_raw (CV_16UC1) and
-  // timestamp_s; sequence and the stamps are set by step().
+  // The frame to fill before step(): write bgr (CV_8UC3, camera size), depth_raw (CV_16UC1, the
+  // depth camera's size: camera.depthWidth() x depthHeight()) and timestamp_s; sequence and the
+  // stamps are set by step(). Unregistered depth is registered by the runner's register stage.
   OdometrySlot& slot() { return slot_; }
   // One frame through extract, track and map. The tracked result is slot().tracked->output.
   Status step();
@@ -44,7 +45,7 @@ class OdometryStepper {
   Status finish();
 
   uint64_t frames() const { return frames_; }
-  uint64_t extractionFailures() const { return extract_.failures(); }
+  uint64_t extractionFailures() const { return extract_.failures() + register_.failures(); }
 
  private:
   OdometrySystem& system_;
@@ -52,6 +53,7 @@ class OdometryStepper {
   OdometrySlot slot_;
   DropLog drops_;        // stays empty: nothing is dropped when the caller pushes frames
   MapperFence fence_{false};  // lock-step: never waits
+  RegisterStage register_;
   ExtractStage extract_;
   TrackStage track_;
   std::unique_ptr<LoopStage> loop_;  // before map_, which is given it
