@@ -70,6 +70,11 @@ Status RecordingSource::overrideCamera(const PinholeCamera& camera) {
     return Status::Error(path_ + ": camera is " + std::to_string(camera.width) + "x" +
                          std::to_string(camera.height) + " but the recording is " +
                          std::to_string(camera_.width) + "x" + std::to_string(camera_.height));
+  // Its depth images have the recording's size: a depth camera of another size cannot have made them.
+  if (camera.depthWidth() != camera_.width || camera.depthHeight() != camera_.height)
+    return Status::Error(path_ + ": the camera's depth camera is " + std::to_string(camera.depthWidth()) + "x" +
+                         std::to_string(camera.depthHeight()) + " but the recording's depth images are " +
+                         std::to_string(camera_.width) + "x" + std::to_string(camera_.height));
   camera_ = camera;
   return Status::Ok();
 }

@@ -157,7 +157,7 @@ TEST(DepthRegistration, IdentityGeometryGivesTheInputBack) {
   cv::Mat depth(480, 640, CV_16UC1);
   cv::randu(depth, 100, 40000);  // 2 cm .. 8 m (nearer than 1 cm is dropped)
   for (int i = 0; i < 640 * 480; i += 7) depth.at<uint16_t>(i) = 0;  // holes stay holes
-  const DepthRegistration registration(camera);
+  DepthRegistration registration(camera);
   ASSERT_TRUE(registration.active());
   cv::Mat out;
   ASSERT_TRUE(registration.registerInto(depth, kFactor, out));
@@ -165,11 +165,11 @@ TEST(DepthRegistration, IdentityGeometryGivesTheInputBack) {
 }
 
 TEST(DepthRegistration, InactiveForRegisteredCamerasAndWrongSizes) {
-  const DepthRegistration none(colourCamera(false));
+  DepthRegistration none(colourCamera(false));
   cv::Mat depth(480, 640, CV_16UC1, cv::Scalar(1000)), out;
   EXPECT_FALSE(none.active());
   EXPECT_FALSE(none.registerInto(depth, kFactor, out));
-  const DepthRegistration qvga(withDepthCamera(colourCamera(false), offsetDepthCamera(320, 240)));
+  DepthRegistration qvga(withDepthCamera(colourCamera(false), offsetDepthCamera(320, 240)));
   EXPECT_FALSE(qvga.registerInto(depth, kFactor, out));  // 640x480 is not the depth camera's size
   EXPECT_TRUE(out.empty());
   cv::Mat wrong_type(240, 320, CV_32FC1, cv::Scalar(1));
@@ -183,7 +183,7 @@ void expectFrontoParallelPlane(const DepthCamera& d, bool distorted) {
   ASSERT_EQ(camera.validate(), "");
   const std::vector<Patch> scene = {frontoParallel(2.0)};
   const cv::Mat depth = renderDepthCamera(d, scene);
-  const DepthRegistration registration(camera);
+  DepthRegistration registration(camera);
   cv::Mat out;
   ASSERT_TRUE(registration.registerInto(depth, kFactor, out));
   int checked = 0, wrong = 0, empty = 0;
@@ -231,7 +231,7 @@ TEST(DepthRegistration, TiltedPlaneReadsTheAnalyticDepthPerPixel) {
   Patch plane{Eigen::Vector3d(0, 0, 2.5) - 1e3 * (R.col(0) + R.col(1)), R.col(0), R.col(1), 2e3, 2e3};
   const std::vector<Patch> scene = {plane};
   const cv::Mat depth = renderDepthCamera(d, scene);
-  const DepthRegistration registration(camera);
+  DepthRegistration registration(camera);
   cv::Mat out;
   ASSERT_TRUE(registration.registerInto(depth, kFactor, out));
   int checked = 0, wrong = 0;
@@ -277,7 +277,7 @@ CardResult registerCard(const PinholeCamera& colour, const DepthCamera& true_dep
   const std::vector<Patch> scene = {card, frontoParallel(3.0)};
   const cv::Mat depth = renderDepthCamera(true_depth_camera, scene);
   const PinholeCamera camera = withDepthCamera(colour, assumed_depth_camera);
-  const DepthRegistration registration(camera);
+  DepthRegistration registration(camera);
   cv::Mat out;
   CardResult r;
   if (!registration.registerInto(depth, kFactor, out)) return r;
@@ -376,7 +376,7 @@ TEST(DepthRegistration, AllocatesNothingPerFrame) {
   const DepthCamera d = offsetDepthCamera();
   const PinholeCamera camera = withDepthCamera(colourCamera(true), d);
   const cv::Mat depth = renderDepthCamera(d, {frontoParallel(2.0)});
-  const DepthRegistration registration(camera);
+  DepthRegistration registration(camera);
   cv::Mat out;
   ASSERT_TRUE(registration.registerInto(depth, kFactor, out));  // sizes `out` once
   const AllocationScope scope;
