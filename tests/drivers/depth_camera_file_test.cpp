@@ -18,7 +18,7 @@ namespace {
 using testing::TempDir;
 
 const char* const kColour = "fx 525\nfy 525\ncx 319.5\ncy 239.5\n";
-// A Kinect-like depth camera 2.5 cm beside the colour camera, turned ~0.5 degrees.
+// A Kinect-like depth camera 2.5 cm beside the colour camera, turned 0.54 degrees.
 const char* const kDepth =
     "depth_fx 575\ndepth_fy 575\ndepth_cx 314\ndepth_cy 243\ndepth_width 640\ndepth_height 480\n"
     "depth_to_colour_qx 0.0015\ndepth_to_colour_qy -0.004\ndepth_to_colour_qz 0.002\n"
@@ -63,7 +63,7 @@ TEST(DepthCameraFile, KeysAreReadAndRoundTripBitForBit) {
   EXPECT_EQ(d.width, 640);
   EXPECT_EQ(d.qw, 0.99998775);  // kept as written (normalised only when used)
   EXPECT_EQ(d.tx, 0.025);
-  EXPECT_NEAR(d.rotationDeg(), 0.53, 0.01);
+  EXPECT_NEAR(d.rotationDeg(), 0.54, 0.01);
   EXPECT_NEAR(d.T_colour_depth().translation().z(), -0.002, 1e-15);
 
   camera.depth_camera->k1 = 0.1 / 3;  // values without a short decimal form
@@ -123,7 +123,7 @@ TEST(DepthCameraFile, OneDepthKeyNeedsAllOfThem) {
 }
 
 TEST(DepthCameraFile, EachPlausibilityBoundHasItsMessage) {
-  expectBoundMessage(depthWith("depth_to_colour_tx", "25"), "translation is 25.00");
+  expectBoundMessage(depthWith("depth_to_colour_tx", "25"), "translation is 25 m long");
   expectBoundMessage(depthWith("depth_to_colour_tx", "25"), "not millimetres");
   expectBoundMessage(depthWith("depth_to_colour_qw", "0.5"), "unit quaternion");
   // 40 degrees about y: quaternion (0, sin 20, 0, cos 20).

@@ -75,6 +75,10 @@ inline OdometryRun runOdometry(FrameSource& source, const SystemOptions& options
   std::unique_ptr<OdometrySystem> system;
   run.status = OdometrySystem::create(source.camera(), options, &system);
   if (!run.status.ok()) return run;
+  // Sized up front when the source knows its length, so the sink does not allocate per frame and
+  // the run's own allocation count (OdometryRunResult::allocations_after_warmup) is the pipeline's.
+  run.trajectory.reserve(source.frameCount());
+  run.references.reserve(source.frameCount());
   CollectingSink sink(*system, settings.keep_outputs, &run);
   sink.on_frame = settings.on_frame;
   SourceCapture capture(source);
