@@ -16,6 +16,7 @@
 #include <optional>
 #include <vector>
 
+#include "drivers/synth/synthetic_scene.h"
 #include "pipeline/frontend/depth_registration.h"
 #include "platform/allocation_counter.h"
 
@@ -41,26 +42,9 @@ PinholeCamera colourCamera(bool distorted) {
 }
 
 // Kinect-like: other focal length and principal point, 2.5 cm to the side, a few mm up and back,
-// turned about half a degree.
-DepthCamera offsetDepthCamera(int width = 640, int height = 480) {
-  DepthCamera d;
-  const double scale = width / 640.0;
-  d.fx = 575 * scale;
-  d.fy = 575 * scale;
-  d.cx = (314.0 + 0.5) * scale - 0.5;
-  d.cy = (243.0 + 0.5) * scale - 0.5;
-  d.width = width;
-  d.height = height;
-  const Eigen::Vector3d w(0.003, -0.008, 0.004);
-  const Eigen::Quaterniond q(Eigen::AngleAxisd(w.norm(), w.normalized()));
-  d.qx = q.x();
-  d.qy = q.y();
-  d.qz = q.z();
-  d.qw = q.w();
-  d.tx = 0.025;
-  d.ty = 0.001;
-  d.tz = -0.002;
-  return d;
+// turned about half a degree (the synthetic scenes' offset depth camera, 640x480 or 320x240).
+DepthCamera offsetDepthCamera(int width = 640) {
+  return width == 640 ? synthOffsetDepthCamera() : synthOffsetDepthCameraQvga();
 }
 
 // A rectangle (or an unbounded plane) in the colour camera's frame: points origin + a u + b v,
@@ -169,7 +153,7 @@ TEST(DepthRegistration, InactiveForRegisteredCamerasAndWrongSizes) {
   cv::Mat depth(480, 640, CV_16UC1, cv::Scalar(1000)), out;
   EXPECT_FALSE(none.active());
   EXPECT_FALSE(none.registerInto(depth, kFactor, out));
-  DepthRegistration qvga(withDepthCamera(colourCamera(false), offsetDepthCamera(320, 240)));
+  DepthRegistration qvga(withDepthCamera(colourCamera(false), offsetDepthCamera(320)));
   EXPECT_FALSE(qvga.registerInto(depth, kFactor, out));  // 640x480 is not the depth camera's size
   EXPECT_TRUE(out.empty());
   cv::Mat wrong_type(240, 320, CV_32FC1, cv::Scalar(1));
@@ -210,7 +194,7 @@ TEST(DepthRegistration, PlaneFacingTheColourCameraReadsItsExactDepth) {
 }
 
 TEST(DepthRegistration, HalfResolutionDepthCameraLeavesNoCracks) {
-  expectFrontoParallelPlane(offsetDepthCamera(320, 240), false);
+  expectFrontoParallelPlane(offsetDepthCamera(320), false);
 }
 
 TEST(DepthRegistration, DistortedLensesAreApplied) {
