@@ -10,6 +10,7 @@
 #include "dataset_test_support.h"
 #include "drivers/dataset/camera_file.h"
 #include "drivers/dataset/camera_presets.h"
+#include "drivers/recording/recording_source.h"
 #include "drivers/recording/recording_writer.h"
 
 namespace plumb {
@@ -149,6 +150,47 @@ TEST(DepthCameraFile, RecordingsRefuseUnregisteredDepthInsteadOfLosingIt) {
   const Status st = RecordingWriter::open(dir.file("r.plumbrec"), camera, RecordingWriterOptions(), &writer);
   ASSERT_FALSE(st.ok());
   EXPECT_NE(st.message().find("not registered to colour"), std::string::npos) << st.message();
+}
+
+// A recording of colour-sized unregistered depth (written under its colour camera) replays with
+// the depth camera given as its camera; a depth camera of another size cannot have made it.
+TEST(DepthCameraFile, RecordingReplaysUnderADepthCameraOfItsSizeOnly) {
+  PinholeCamera unregistered;
+  ASSERT_TRUE(readText(std::string(kColour) + kDepth, &unregistered).ok());
+  PinholeCamera colour_only = unregistered;
+  colour_only.depth_camera.reset();
+  TempDir dir;
+  {
+    std::unique_ptr<RecordingWriter> writer;
+    ASSERT_TRUE(RecordingWriter::open(dir.file("r.plumbrec"), colour_only, RecordingWriterOptions(), &writer).ok());
+    RgbdImage frame;
+    frame.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar(1, 2, 3));
+    frame.depth_raw = cv::Mat(480, 640, CV_16UC1, cv::Scalar(7000));
+    frame.timestamp_s = frame.depth_timestamp_s = 1.0;
+    ASSERT_TRUE(writer->append(frame).ok());
+    ASSERT_TRUE(writer->close().ok());
+  }
+  std::unique_ptr<RecordingSource> source;
+  ASSERT_TRUE(RecordingSource::open(dir.file("r.plumbrec"), &source).ok());
+  ASSERT_TRUE(source->overrideCamera(unregistered).ok());
+  EXPECT_FALSE(source->camera().depthRegistered());
+  RgbdImage out;
+  ASSERT_EQ(source->next(out), SourceResult::kFrame);
+  EXPECT_EQ(out.depth_raw.at<uint16_t>(10, 10), 7000);
+
+  PinholeCamera qvga_depth = unregistered;
+  qvga_depth.depth_camera = std::nullopt;
+  ASSERT_TRUE(readText(std::string(kColour) + depthWith({{"depth_fx", "287.5"}, {"depth_fy", "287.5"},
+                                                         {"depth_cx", "157"}, {"depth_cy", "121.5"},
+                                                         {"depth_width", "320"}, {"depth_height", "240"}}),
+                       &qvga_depth)
+                  .ok());
+  ASSERT_TRUE(RecordingSource::open(dir.file("r.plumbrec"), &source).ok());
+  const Status st = source->overrideCamera(qvga_depth);
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.message().find("depth camera is 320x240 but the recording's depth images are 640x480"),
+            std::string::npos)
+      << st.message();
 }
 
 }  // namespace
