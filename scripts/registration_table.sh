@@ -7,7 +7,9 @@
 #   without      the same offset depth read under a camera file without the depth camera, i.e.
 #                used as if it were registered (what happens when the calibration is missing).
 # Colour images and ground truth are identical in all three. Also prints the register stage's
-# mean milliseconds per frame (from --stats).
+# mean wall milliseconds per frame (from --stats: a loaded machine inflates it; `plumb bench
+# frontend --clock cpu` measures CPU time). POINTS_ONLY=1 adds the two offset runs with --no-lines
+# (points-only against points+lines, with and without registration).
 #   scripts/registration_table.sh [PRESETS] [SEEDS] [FRAMES]
 #     (default: "textured low_texture fast_rotation" "1 2 3" 300; PLUMB=build/bin/plumb)
 set -euo pipefail
@@ -30,8 +32,14 @@ run() {  # name dataset [plumb run options...]
     --stats "$WORK/$name.json" "$@" > "$WORK/$name.log" 2>&1 || { echo "run $name failed:"; tail -3 "$WORK/$name.log"; }
 }
 
-printf '| preset | seed | registered ATE | with registration ATE | without registration ATE | register ms/frame |\n'
-printf '|---|---|---|---|---|---|\n'
+POINTS_ONLY=${POINTS_ONLY:-0}
+if [ "$POINTS_ONLY" = 1 ]; then
+  printf '| preset | seed | registered ATE | with registration ATE | without registration ATE | with reg., points only | without reg., points only | register ms/frame (wall) |\n'
+  printf '|---|---|---|---|---|---|---|---|\n'
+else
+  printf '| preset | seed | registered ATE | with registration ATE | without registration ATE | register ms/frame (wall) |\n'
+  printf '|---|---|---|---|---|---|\n'
+fi
 for preset in $PRESETS; do
   for seed in $SEEDS; do
     reg="$WORK/reg_${preset}_$seed" off="$WORK/off_${preset}_$seed"
@@ -44,9 +52,15 @@ for preset in $PRESETS; do
     run "r_$preset$seed" "$reg"
     run "w_$preset$seed" "$off"
     run "n_$preset$seed" "$off" --camera "$WORK/colour_only.txt"
-    printf '| %s | %s | %s | %s | %s | %s |\n' "$preset" "$seed" \
+    points_only=""
+    if [ "$POINTS_ONLY" = 1 ]; then
+      run "wp_$preset$seed" "$off" --no-lines
+      run "np_$preset$seed" "$off" --camera "$WORK/colour_only.txt" --no-lines
+      points_only="$(ate_of "$WORK/wp_$preset$seed.log") | $(ate_of "$WORK/np_$preset$seed.log") | "
+    fi
+    printf '| %s | %s | %s | %s | %s | %s%s |\n' "$preset" "$seed" \
       "$(ate_of "$WORK/r_$preset$seed.log")" "$(ate_of "$WORK/w_$preset$seed.log")" \
-      "$(ate_of "$WORK/n_$preset$seed.log")" "$(register_ms_of "$WORK/w_$preset$seed.json")"
+      "$(ate_of "$WORK/n_$preset$seed.log")" "$points_only" "$(register_ms_of "$WORK/w_$preset$seed.json")"
     rm -rf "$reg" "$off"
   done
 done
