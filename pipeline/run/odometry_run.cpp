@@ -57,15 +57,15 @@ Status runOdometry(FrameCapture& capture, OdometrySystem& system, OdometrySink& 
   // cores, and each fresh pool worker allocates thread-local state the first time it runs a
   // cv::parallel_for_ body, i.e. at unpredictable frames of a steady run.
   cv::setNumThreads(0);
-  // Real time: mapping is off the latency path (poses are known when tracking is done), so under
-  // contention the kernel serves capture, extract and track first. Nice 5, not more: the map stage
-  // must still keep up on average, or the slots fill and frames drop. Not in fast mode, where every
-  // stage is on the throughput path.
   // A camera whose depth is not registered to colour gets a register stage before extraction
   // (its own thread in the threaded modes, its own trace track and report row); others run
   // without it, exactly as before it existed.
   RegisterStage register_stage(system.camera());
   const int first_stage = register_stage.needed() ? 2 : 1;  // index of the extract stage
+  // Real time: mapping is off the latency path (poses are known when tracking is done), so under
+  // contention the kernel serves capture, extract and track first. Nice 5, not more: the map stage
+  // must still keep up on average, or the slots fill and frames drop. Not in fast mode, where every
+  // stage is on the throughput path.
   if (schedule.mode == runtime::RunMode::kRealtime) {
     schedule.background_stages = 1u << (first_stage + 2);  // the map stage
     schedule.background_nice = 5;

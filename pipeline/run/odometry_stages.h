@@ -26,7 +26,7 @@ struct OdometrySlot {
   std::unique_ptr<FrameFeatures> features = std::make_unique<FrameFeatures>();
   std::unique_ptr<TrackedFrame> tracked = std::make_unique<TrackedFrame>();  // track -> map
   // Unregistered depth cameras only: image.depth_raw registered into the colour camera by the
-  // register stage (sized on a slot's first frame, reused after), and whether this frame's is valid.
+  // register stage (sized once, with the pool), and whether this frame's is valid.
   cv::Mat registered_depth;
   bool depth_registered = false;
   double register_ms = 0;
@@ -89,7 +89,8 @@ class RegisterStage final : public runtime::Stage<OdometrySlot> {
   uint64_t failures_ = 0;
 };
 
-// Stage 1 (2 after a register stage): its own FeatureExtractor (extractors are one per thread), the system's camera and options.
+// Stage 1 (2 after a register stage): its own FeatureExtractor (extractors are one per thread), the
+// system's camera and options. Reads the registered depth when there is a register stage.
 class ExtractStage final : public runtime::Stage<OdometrySlot> {
  public:
   explicit ExtractStage(const OdometrySystem& system);
