@@ -17,12 +17,6 @@ Status RecordingWriter::open(const std::string& path, const PinholeCamera& camer
                              std::unique_ptr<RecordingWriter>* out) {
   const std::string problem = camera.validate();
   if (!problem.empty()) return Status::Error(path + ": camera invalid: " + problem);
-  // The format's header has no place for a separate depth camera: writing such frames would turn
-  // unregistered depth into "registered" depth on replay, a silently wrong answer.
-  if (!camera.depthRegistered())
-    return Status::Error(path + ": the camera's depth is not registered to colour (it describes a depth camera); "
-                                "recordings (format version 2) hold registered depth only. Replay the source "
-                                "directly, or register the depth first");
   if (options.png_compression < 0 || options.png_compression > 9)
     return Status::Error(path + ": png_compression must be 0..9");
   std::unique_ptr<RecordingWriter> writer(new RecordingWriter());
@@ -49,8 +43,11 @@ Status RecordingWriter::append(const RgbdImage& frame) {
       frame.bgr.rows != camera_.height)
     return Status::Error(path_ + ": colour image must be CV_8UC3 " + std::to_string(camera_.width) +
                          "x" + std::to_string(camera_.height));
-  if (frame.depth_raw.type() != CV_16UC1 || frame.depth_raw.size() != frame.bgr.size())
-    return Status::Error(path_ + ": depth image must be CV_16UC1 of the colour image's size");
+  // Unregistered depth (a version 3 file) has the depth camera's size, registered depth the colour's.
+  if (frame.depth_raw.type() != CV_16UC1 || frame.depth_raw.cols != camera_.depthWidth() ||
+      frame.depth_raw.rows != camera_.depthHeight())
+    return Status::Error(path_ + ": depth image must be CV_16UC1 " + std::to_string(camera_.depthWidth()) + "x" +
+                         std::to_string(camera_.depthHeight()));
 
   chunk_.clear();
   beginChunk(ChunkType::kFrame, chunk_);

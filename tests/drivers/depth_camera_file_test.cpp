@@ -1,6 +1,6 @@
 // Unregistered depth in camera files (docs/DATA_FORMATS.md "Unregistered depth"): the keys, the
 // exact round trip, the all-or-nothing rule, each plausibility bound with its message; presets
-// stay registered; recordings and the public API refuse such a camera rather than lose it.
+// stay registered; recordings keep the depth camera (format version 3) or are replayed under one.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -142,14 +142,66 @@ TEST(DepthCameraFile, EachPlausibilityBoundHasItsMessage) {
   expectBoundMessage(away, "falls outside the colour image");
 }
 
-TEST(DepthCameraFile, RecordingsRefuseUnregisteredDepthInsteadOfLosingIt) {
+// A recording made with an unregistered depth camera is a version 3 file: the depth camera is in
+// its header (bit for bit) and its depth images keep their own size; registered cameras still
+// write version 2.
+TEST(DepthCameraFile, RecordingsKeepTheDepthCameraAndItsImageSize) {
   PinholeCamera camera;
-  ASSERT_TRUE(readText(std::string(kColour) + kDepth, &camera).ok());
+  ASSERT_TRUE(readText(std::string(kColour) + depthWith({{"depth_fx", "287.5"}, {"depth_fy", "287.5"},
+                                                         {"depth_cx", "157"}, {"depth_cy", "121.5"},
+                                                         {"depth_width", "320"}, {"depth_height", "240"}}),
+                       &camera)
+                  .ok());
   TempDir dir;
+  for (const ImageCodec codec : {ImageCodec::kRaw, ImageCodec::kPng}) {
+    SCOPED_TRACE(codec == ImageCodec::kRaw ? "raw" : "png");
+    const std::string path = dir.file(codec == ImageCodec::kRaw ? "raw.plumbrec" : "png.plumbrec");
+    RecordingWriterOptions options;
+    options.colour_codec = options.depth_codec = codec;
+    {
+      std::unique_ptr<RecordingWriter> writer;
+      ASSERT_TRUE(RecordingWriter::open(path, camera, options, &writer).ok());
+      RgbdImage frame;
+      frame.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar(1, 2, 3));
+      frame.depth_raw = cv::Mat(480, 640, CV_16UC1, cv::Scalar(7000));  // the colour size: refused
+      frame.timestamp_s = frame.depth_timestamp_s = 1.0;
+      const Status refused = writer->append(frame);
+      ASSERT_FALSE(refused.ok());
+      EXPECT_NE(refused.message().find("320x240"), std::string::npos) << refused.message();
+      frame.depth_raw = cv::Mat(240, 320, CV_16UC1, cv::Scalar(7000));
+      frame.depth_raw.at<uint16_t>(239, 319) = 1234;
+      ASSERT_TRUE(writer->append(frame).ok());
+      ASSERT_TRUE(writer->close().ok());
+    }
+    EXPECT_EQ(testing::readWholeFile(path)[8], 3);  // version 3
+    std::unique_ptr<RecordingSource> source;
+    const Status st = RecordingSource::open(path, &source);
+    ASSERT_TRUE(st.ok()) << st.message();
+    ASSERT_FALSE(source->camera().depthRegistered());
+    const DepthCamera& a = *camera.depth_camera;
+    const DepthCamera& b = *source->camera().depth_camera;
+    for (const auto field : {&DepthCamera::fx, &DepthCamera::fy, &DepthCamera::cx, &DepthCamera::cy, &DepthCamera::qx,
+                             &DepthCamera::qy, &DepthCamera::qz, &DepthCamera::qw, &DepthCamera::tx, &DepthCamera::ty,
+                             &DepthCamera::tz}) {
+      EXPECT_EQ(a.*field, b.*field);
+    }
+    EXPECT_EQ(b.width, 320);
+    RgbdImage out;
+    ASSERT_EQ(source->next(out), SourceResult::kFrame);
+    ASSERT_EQ(out.depth_raw.size(), cv::Size(320, 240));
+    EXPECT_EQ(out.depth_raw.at<uint16_t>(239, 319), 1234);
+    EXPECT_EQ(out.depth_raw.at<uint16_t>(0, 0), 7000);
+    EXPECT_EQ(out.bgr.size(), cv::Size(640, 480));
+    EXPECT_EQ(source->next(out), SourceResult::kEndOfStream);
+    EXPECT_EQ(source->stats().chunks_skipped, 0u);
+  }
+  // A registered camera still writes version 2.
+  PinholeCamera registered = camera;
+  registered.depth_camera.reset();
   std::unique_ptr<RecordingWriter> writer;
-  const Status st = RecordingWriter::open(dir.file("r.plumbrec"), camera, RecordingWriterOptions(), &writer);
-  ASSERT_FALSE(st.ok());
-  EXPECT_NE(st.message().find("not registered to colour"), std::string::npos) << st.message();
+  ASSERT_TRUE(RecordingWriter::open(dir.file("v2.plumbrec"), registered, RecordingWriterOptions(), &writer).ok());
+  ASSERT_TRUE(writer->close().ok());
+  EXPECT_EQ(testing::readWholeFile(dir.file("v2.plumbrec"))[8], 2);
 }
 
 // A recording of colour-sized unregistered depth (written under its colour camera) replays with
