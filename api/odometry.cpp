@@ -35,6 +35,12 @@ Status resolveCamera(const CameraSpec& spec, CameraValues* out) {
     if (spec.name_or_file.empty()) return Status::Error("camera: give a preset (tum1 tum2 tum3 icl), a file or values");
     const ::plumb::Status st = cameraFromSpec(spec.name_or_file, &camera);
     if (!st.ok()) return fromStatus(st);
+    // CameraValues (the installed header) has no depth camera: taking such a file would read
+    // unregistered depth as registered.
+    if (!camera.depthRegistered()) {
+      return Status::Error(spec.name_or_file + ": describes a depth camera not registered to colour; the API takes "
+                           "registered depth only (`plumb run` registers it)");
+    }
   }
   *out = toValues(camera);
   return Status::Ok();

@@ -37,9 +37,13 @@ std::string imageProblem(int type, int width, int height, bool is_depth, const P
   const int expected_type = is_depth ? CV_16UC1 : CV_8UC3;
   if (type != expected_type)
     return typeName(type) + " image, expected " + (is_depth ? "16-bit 1-channel depth" : "8-bit 3-channel colour");
-  if (width != camera.width || height != camera.height)
-    return "size " + std::to_string(width) + "x" + std::to_string(height) + ", camera expects " +
-           std::to_string(camera.width) + "x" + std::to_string(camera.height);
+  // Depth from an unregistered depth camera has that camera's size (registered later, in the pipeline).
+  const int expected_width = is_depth ? camera.depthWidth() : camera.width;
+  const int expected_height = is_depth ? camera.depthHeight() : camera.height;
+  if (width != expected_width || height != expected_height)
+    return "size " + std::to_string(width) + "x" + std::to_string(height) + ", " +
+           (is_depth && !camera.depthRegistered() ? "depth camera" : "camera") + " expects " +
+           std::to_string(expected_width) + "x" + std::to_string(expected_height);
   return "";
 }
 

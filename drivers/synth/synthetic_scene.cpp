@@ -6,6 +6,7 @@
 #include "drivers/synth/camera_path.h"
 #include "drivers/synth/corridor_layout.h"
 #include "drivers/synth/corridor_path.h"
+#include "drivers/synth/depth_camera_view.h"
 #include "drivers/synth/frame_renderer.h"
 #include "drivers/synth/room_layout.h"
 #include "drivers/synth/sensor_model.h"
@@ -67,7 +68,7 @@ Status validate(const SynthOptions& o) {
   const double max_representable_m = 65535.0 / synthCamera().depth_factor;
   if (!(o.min_depth_m >= 0 && o.min_depth_m < o.max_depth_m && o.max_depth_m <= max_representable_m))
     return Status::Error("synth: need 0 <= min_depth_m < max_depth_m <= " + std::to_string(max_representable_m));
-  return Status::Ok();
+  return synth::validateDepthCamera(o);
 }
 
 PinholeCamera synthCamera() {
@@ -92,6 +93,10 @@ class SyntheticSceneImpl {
         path_(pathOptions(options)),
         corridor_path_(synth::CorridorPathOptions{options.seed}),
         renderer_(model_, camera_) {
+    if (options.depth_camera) {
+      camera_.depth_camera = options.depth_camera;
+      depth_view_ = std::make_unique<synth::DepthCameraView>(model_, *options.depth_camera);
+    }
     sensor_.pixel_noise_sigma = options.pixel_noise_sigma;
     sensor_.depth_noise = options.depth_noise;
     sensor_.depth_noise_k = options.depth_noise_k;
@@ -139,6 +144,7 @@ class SyntheticSceneImpl {
   synth::CameraPath path_;
   synth::CorridorPath corridor_path_;
   synth::FrameRenderer renderer_;  // scratch buffers: why render() is not reentrant
+  std::unique_ptr<synth::DepthCameraView> depth_view_;  // SynthOptions::depth_camera only
   synth::SensorModelOptions sensor_;
   uint64_t noise_seed_ = 0;
 };
@@ -166,10 +172,13 @@ Status SyntheticScene::render(int i, RgbdImage& out) const {
   if (i < 0) return Status::Error("synth: frame index must be >= 0 (got " + std::to_string(i) + ")");
   SyntheticSceneImpl& impl = *impl_;
   impl.renderer_.render(T_world_cam(i));
+  // Unregistered depth: the depth camera's own view, in its own image (depth_camera_view.h).
+  if (impl.depth_view_) impl.depth_view_->render(T_world_cam(i));
+  const cv::Mat& depth_m = impl.depth_view_ ? impl.depth_view_->depth() : impl.renderer_.depth();
   // Colour and depth are quantised independently (separate noise streams, separate outputs): on
   // a frame that painted faces (the renderer used its helper thread), one there, one here.
   auto colour = [&] { synth::quantiseColour(impl.renderer_.colour(), impl.sensor_, impl.noise_seed_, i, out.bgr); };
-  auto depth = [&] { synth::quantiseDepth(impl.renderer_.depth(), impl.sensor_, impl.noise_seed_, i, out.depth_raw); };
+  auto depth = [&] { synth::quantiseDepth(depth_m, impl.sensor_, impl.noise_seed_, i, out.depth_raw); };
   if (impl.renderer_.paintedFaces()) {
     impl.renderer_.helper().runBoth(colour, depth);
   } else {

@@ -63,6 +63,7 @@ struct FrameOutput {
   TrackResult track;
   InsertResult insert;
   double extract_ms = 0, track_ms = 0, map_ms = 0;
+  double register_ms = 0;   // depth registration (unregistered depth cameras only; 0 otherwise)
   int64_t t_sensor_ns = 0;  // host monotonic time the frame was captured (set by the runner)
 };
 

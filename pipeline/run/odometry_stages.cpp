@@ -53,10 +53,24 @@ void CaptureStage::skip() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// ExtractStage, TrackStage
+// RegisterStage, ExtractStage, TrackStage
+
+Status RegisterStage::process(OdometrySlot& slot, const runtime::FrameStamps&) {
+  const auto start = std::chrono::steady_clock::now();
+  slot.depth_registered =
+      registration_.registerInto(slot.image.depth_raw, slot.image.depth_factor, slot.registered_depth);
+  // A depth image that does not fit the depth camera is not guessed at: the frame goes on without
+  // depth (2D-only features), counted.
+  if (!slot.depth_registered) ++failures_;
+  slot.register_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return Status::Ok();
+}
 
 ExtractStage::ExtractStage(const OdometrySystem& system, uint32_t stride, uint32_t offset)
-    : extractor_(system.camera(), system.options().odometry.extractor), stride_(stride), offset_(offset) {}
+    : extractor_(system.camera(), system.options().odometry.extractor),
+      stride_(stride),
+      offset_(offset),
+      registered_depth_(!system.camera().depthRegistered()) {}
 
 const char* ExtractStage::name() const {
   if (stride_ == 1) return "extract";
@@ -66,8 +80,13 @@ const char* ExtractStage::name() const {
 Status ExtractStage::process(OdometrySlot& slot, const runtime::FrameStamps& stamps) {
   if (stamps.frame_index % stride_ != offset_) return Status::Ok();
   const auto start = std::chrono::steady_clock::now();
+  // Unregistered depth is never read as it came: registered, or none at all.
+  static const cv::Mat kNoDepth;
+  const cv::Mat& depth = !registered_depth_ ? slot.image.depth_raw
+                         : slot.depth_registered ? slot.registered_depth
+                                                 : kNoDepth;
   // A frame that does not fit the camera is tracked featureless (and counted): it keeps its place.
-  if (!extractor_.extract(slot.image, *slot.features)) {
+  if (!extractor_.extract(slot.image.bgr, depth, slot.image.depth_factor, *slot.features)) {
     slot.features->clear();
     ++failures_;
   }
@@ -78,6 +97,7 @@ Status ExtractStage::process(OdometrySlot& slot, const runtime::FrameStamps& sta
 Status TrackStage::process(OdometrySlot& slot, const runtime::FrameStamps&) {
   system_.trackFeatures(*slot.features, slot.image.sequence, slot.image.timestamp_s, &fence_, slot.tracked.get());
   slot.tracked->output.extract_ms = slot.extract_ms;
+  slot.tracked->output.register_ms = slot.register_ms;
   slot.tracked->output.t_sensor_ns = slot.image.t_sensor_ns;
   fence_.frameTracked();
   sink_.onPose(slot.tracked->output);

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 
+#include "pipeline/frontend/depth_registration.h"
 #include "pipeline/frontend/feature_extractor.h"
 #include "pipeline/odometry/mapper_fence.h"
 #include "pipeline/odometry/odometry_system.h"
@@ -24,6 +25,11 @@ struct OdometrySlot {
   RgbdImage image;
   std::unique_ptr<FrameFeatures> features = std::make_unique<FrameFeatures>();
   std::unique_ptr<TrackedFrame> tracked = std::make_unique<TrackedFrame>();  // track -> map
+  // Unregistered depth cameras only: image.depth_raw registered into the colour camera by the
+  // register stage (sized once, with the pool), and whether this frame's is valid.
+  cv::Mat registered_depth;
+  bool depth_registered = false;
+  double register_ms = 0;
   double extract_ms = 0;
   uint32_t dropped_before = 0;  // DropLog entries that precede this frame
 };
@@ -66,7 +72,26 @@ class CaptureStage final : public runtime::Source<OdometrySlot> {
   bool stopped_ = false;
 };
 
-// Its own FeatureExtractor (extractors are one per thread), the system's camera and options. With
+// Stage 1 when the camera's depth is not registered to colour (PinholeCamera::depth_camera; RunSession
+// leaves it out otherwise): image.depth_raw, as the depth camera saw it, into the colour camera
+// (pipeline/frontend/depth_registration.h), once per frame, into the slot's registered_depth.
+class RegisterStage final : public runtime::Stage<OdometrySlot> {
+ public:
+  explicit RegisterStage(const PinholeCamera& camera) : registration_(camera) {}
+  const char* name() const override { return "register"; }
+  Status process(OdometrySlot& slot, const runtime::FrameStamps&) override;
+  // Whether the camera needs it (a stage that would do nothing is not run at all).
+  bool needed() const { return registration_.active(); }
+  // Frames whose depth image did not fit the depth camera (their features are 2D-only).
+  uint64_t failures() const { return failures_; }
+
+ private:
+  DepthRegistration registration_;
+  uint64_t failures_ = 0;
+};
+
+// After the register stage, if any: its own FeatureExtractor (extractors are one per thread), the
+// system's camera and options; reads the registered depth when there is a register stage. With
 // stride 2 two of them follow each other in the chain, one extracting the even frames and passing
 // the odd ones on, the other the reverse: the threaded modes extract two frames at once on two
 // threads without fan-out (extraction is a function of the frame alone, so the features, and the
@@ -82,6 +107,7 @@ class ExtractStage final : public runtime::Stage<OdometrySlot> {
  private:
   FeatureExtractor extractor_;
   uint32_t stride_, offset_;
+  bool registered_depth_ = false;  // read slot.registered_depth (there is a register stage)
   uint64_t failures_ = 0;
 };
 

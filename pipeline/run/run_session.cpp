@@ -45,6 +45,7 @@ RunSession::RunSession(std::unique_ptr<OdometrySystem> system, OdometrySink& sin
       system_(std::move(system)),
       sink_(sink),
       fence_(fenceFor(options)),
+      register_(system_->camera()),
       // Threaded: two extract stages, even and odd frames, so that extraction (the largest stage,
       // about half of a frame's work) is not the pipeline's bottleneck on two cores.
       extract_(*system_, oneThread(options.schedule) ? 1 : 2, 0),
@@ -99,7 +100,7 @@ Status RunSession::restoreLoadedMap() {
 }
 
 uint64_t RunSession::extractionFailures() const {
-  return extract_.failures() + (extract_odd_ ? extract_odd_->failures() : 0);
+  return register_.failures() + extract_.failures() + (extract_odd_ ? extract_odd_->failures() : 0);
 }
 
 Status RunSession::run(FrameCapture& capture) {
@@ -111,7 +112,12 @@ Status RunSession::run(FrameCapture& capture) {
   // The trace is read only for `--profile` (keep_trace). Without it, reserving it would cost
   // 40 B x 8192 per stage that a long run fills and makes resident frame after frame.
   if (!options_.keep_trace) schedule.trace_capacity_per_stage = 0;
-  std::vector<runtime::Stage<OdometrySlot>*> stages{&extract_};
+  // A camera whose depth is not registered to colour gets a register stage before extraction
+  // (its own thread in the threaded modes, its own trace track and report row); others run
+  // without it, exactly as before it existed.
+  std::vector<runtime::Stage<OdometrySlot>*> stages;
+  if (register_.needed()) stages.push_back(&register_);
+  stages.push_back(&extract_);
   if (extract_odd_) stages.push_back(extract_odd_.get());
   stages.push_back(&track_);
   const int track_stage = int(stages.size());  // runner numbering: 0 = capture
@@ -129,6 +135,13 @@ Status RunSession::run(FrameCapture& capture) {
 
   CaptureStage capture_stage(capture, options_.max_frames, options_.stop, drops_);
   runtime::StageRunner<OdometrySlot> runner(capture_stage, stages, schedule);
+  // Registered-depth buffers sized once, with the pool (registerInto() then never allocates).
+  if (register_.needed()) {
+    const PinholeCamera& camera = system_->camera();
+    for (std::size_t i = 0; i < runner.pool().size(); ++i) {
+      runner.pool()[runtime::SlotIndex(i)].payload.registered_depth.create(camera.height, camera.width, CV_16UC1);
+    }
+  }
   Status status = runner.run();
   const Status finished = finish();
   if (status.ok()) status = finished;
@@ -143,7 +156,8 @@ OdometrySlot& RunSession::slot() {
     push_slot_ = std::make_unique<OdometrySlot>();
     const PinholeCamera& camera = system_->camera();
     push_slot_->image.bgr.create(camera.height, camera.width, CV_8UC3);
-    push_slot_->image.depth_raw.create(camera.height, camera.width, CV_16UC1);
+    push_slot_->image.depth_raw.create(camera.depthHeight(), camera.depthWidth(), CV_16UC1);
+    if (register_.needed()) push_slot_->registered_depth.create(camera.height, camera.width, CV_16UC1);
     push_slot_->image.depth_factor = camera.depth_factor;
   }
   return *push_slot_;
@@ -164,6 +178,7 @@ Status RunSession::step() {
   s.image.sequence = index;
   s.dropped_before = 0;
   // The runner's lock-step order (runtime::StageRunner in deterministic mode).
+  if (register_.needed()) PLUMB_RETURN_IF_ERROR(register_.process(s, stamps));
   PLUMB_RETURN_IF_ERROR(extract_.process(s, stamps));
   PLUMB_RETURN_IF_ERROR(track_.process(s, stamps));
   return map_.process(s, stamps);

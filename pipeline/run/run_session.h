@@ -1,6 +1,6 @@
 #pragma once
 // RunSession: one odometry run's objects and its protocol, in one place. It owns the system, the
-// extract / track / map stages (pipeline/run/odometry_stages.h; threaded runs: two extract stages,
+// register (depth not registered to colour only) / extract / track / map stages (pipeline/run/odometry_stages.h; threaded runs: two extract stages,
 // even and odd frames), the loop stage and the MapperFence, and is driven one of two ways:
 //
 //   run(capture)  the whole input through runtime::StageRunner in the options' schedule
@@ -49,7 +49,8 @@ class RunSession {
   Status run(FrameCapture& capture);
 
   // Push style, deterministic schedule only. The frame to fill before step(): bgr (CV_8UC3, camera
-  // size), depth_raw (CV_16UC1) and timestamp_s; sequence and the stamps are set by step().
+  // size), depth_raw (CV_16UC1, the depth camera's size: camera.depthWidth() x depthHeight()) and
+  // timestamp_s; sequence and the stamps are set by step().
   OdometrySlot& slot();
   // One frame through extract, track (sink.onPose) and map (sink.onFrame, ...). The tracked result
   // is slot().tracked->output. After warm-up a step allocates nothing.
@@ -74,6 +75,7 @@ class RunSession {
   OdometrySink& sink_;
   DropLog drops_;
   MapperFence fence_;
+  RegisterStage register_;                      // unregistered depth cameras only (needed())
   ExtractStage extract_;                        // every frame; threaded runs: the even ones
   std::unique_ptr<ExtractStage> extract_odd_;   // threaded runs: the odd frames, on a thread of its own
   TrackStage track_;

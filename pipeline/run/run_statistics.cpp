@@ -26,7 +26,11 @@ void RunStatistics::add(const FrameOutput& frame) {
   extract_.add(ns(frame.extract_ms));
   track_.add(ns(frame.track_ms));
   map_.add(ns(frame.map_ms));
-  total_.add(ns(frame.extract_ms + frame.track_ms + frame.map_ms));
+  if (frame.register_ms > 0) {
+    ++frames_registered_;
+    register_.add(ns(frame.register_ms));
+  }
+  total_.add(ns(frame.register_ms + frame.extract_ms + frame.track_ms + frame.map_ms));
   if (rss_every_ > 0 && frames_ % uint64_t(rss_every_) == 0 && rss_.size() < max_checkpoints_) {
     RssCheckpoint c;
     c.frame = frames_;
@@ -80,6 +84,8 @@ std::string runSummaryJson(const RunSummary& r) {
   };
   out += "  \"ms_per_frame\": {\n";
   timing("total", r.statistics->totalNs(), false);
+  // Only runs that registered depth have the row, so the statistics of others are unchanged.
+  if (r.statistics->framesRegistered() > 0) timing("register", r.statistics->registerNs(), false);
   timing("extract", r.statistics->extractNs(), false);
   timing("track", r.statistics->trackNs(), false);
   timing("map", r.statistics->mapNs(), true);

@@ -81,6 +81,10 @@ struct RunSettings {
 
 inline OdometryRun runOdometry(FrameSource& source, const SystemOptions& options, const RunSettings& settings = {}) {
   OdometryRun run;
+  // Sized up front when the source knows its length, so the sink does not allocate per frame and
+  // the run's own allocation count (OdometryRunResult::allocations_after_warmup) is the pipeline's.
+  run.trajectory.reserve(source.frameCount());
+  run.references.reserve(source.frameCount());
   CollectingSink sink(settings.keep_outputs, &run);
   sink.on_frame = settings.on_frame;
   sink.on_pose = settings.on_pose;
