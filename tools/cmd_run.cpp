@@ -236,6 +236,8 @@ int runRun(int argc, char** argv) {
   RunOutputs outputs(output_options);
   RunRecord record;
   st = runToOutputs(*source, system_options, run_options, outputs, &record);
+  const std::string source_health = source->healthReport();  // live sources: faults, reconnects, pairing
+  if (!source_health.empty()) std::printf("%s\n", source_health.c_str());
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
   // The map is written whatever ended the run (a stop, a read error): like the trajectory, it holds

@@ -46,6 +46,10 @@ class FrameSource {
   virtual std::size_t frameCount() const { return 0; }
   // What the source skipped so far (see SourceDamage); none for sources that cannot be damaged.
   virtual SourceDamage damage() const { return SourceDamage{}; }
+  // Live sources: what supervision and capture counted (errors, reconnects, time disconnected,
+  // frames missing, unpaired colour/depth, driver-flagged buffers), for run reports: a summary
+  // line, then one line per recorded event. Empty when there is nothing to report (replays).
+  virtual std::string healthReport() const { return ""; }
 };
 
 }  // namespace plumb

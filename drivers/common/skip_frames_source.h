@@ -34,6 +34,7 @@ class SkipFramesSource : public FrameSource {
     return n > skip_ ? n - std::size_t(skip_) : 0;
   }
   SourceDamage damage() const override { return inner_->damage(); }
+  std::string healthReport() const override { return inner_->healthReport(); }
 
  private:
   std::unique_ptr<FrameSource> inner_;

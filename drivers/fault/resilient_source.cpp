@@ -103,6 +103,26 @@ bool ResilientSource::recover() {
   return false;
 }
 
+std::string ResilientSource::healthReport() const {
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "source: errors %llu, stall timeouts %llu, reconnects %llu (%.3f s disconnected, %llu failed "
+                "reopens), frames missing %llu in %llu gaps",
+                static_cast<unsigned long long>(stats_.errors), static_cast<unsigned long long>(stats_.stall_timeouts),
+                static_cast<unsigned long long>(stats_.reconnects), stats_.time_disconnected_ns * 1e-9,
+                static_cast<unsigned long long>(stats_.reopen_failures),
+                static_cast<unsigned long long>(stats_.frames_missing), static_cast<unsigned long long>(stats_.gaps));
+  const std::string inner = inner_->healthReport();
+  std::string text = inner.empty() ? std::string(line) : std::string(line) + "; " + inner;
+  const std::string events = describeEvents();
+  for (std::size_t start = 0; start < events.size();) {
+    const std::size_t end = events.find('\n', start);
+    text += "\n  " + events.substr(start, end - start);
+    start = end == std::string::npos ? events.size() : end + 1;
+  }
+  return text;
+}
+
 std::string ResilientSource::describeEvents() const {
   std::string text;
   char line[160];

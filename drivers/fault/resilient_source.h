@@ -64,6 +64,10 @@ class ResilientSource : public FrameSource {
   const Status& lastError() const override { return error_; }
   Status reopen() override { return inner_->reopen(); }
   bool isLive() const override { return inner_->isLive(); }
+  // "source: errors N, stall timeouts N, reconnects N (T s disconnected, N failed reopens), frames
+  // missing N in N gaps" and, after "; ", the supervised source's own report; then the events
+  // (describeEvents), each line indented by two spaces.
+  std::string healthReport() const override;
 
   const ResilienceStats& stats() const { return stats_; }
   // One line per event ("t=1.250s error: ..."), for run reports.

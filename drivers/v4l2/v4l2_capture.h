@@ -16,9 +16,11 @@
 
 namespace plumb {
 
-enum class V4l2PixelFormat { kYuyv, kMjpeg, kGrey, kZ16 };
+// kY16 ('Y16 ', 16-bit little-endian grey) is accepted in place of kZ16 on a depth node: same
+// layout, and the format v4l2loopback and some depth cameras announce for depth.
+enum class V4l2PixelFormat { kYuyv, kMjpeg, kGrey, kZ16, kY16 };
 
-// "yuyv", "mjpeg", "grey", "z16".
+// "yuyv", "mjpeg", "grey", "z16", "y16".
 const char* pixelFormatName(V4l2PixelFormat format);
 bool parsePixelFormat(const std::string& name, V4l2PixelFormat* format);
 
@@ -36,9 +38,26 @@ struct V4l2FrameView {
   const uint8_t* data = nullptr;
   std::size_t bytes_used = 0;
   std::size_t stride = 0;     // bytes per line
-  int64_t timestamp_ns = 0;   // driver timestamp (CLOCK_MONOTONIC when the driver says so)
+  // The buffer's kernel timestamp when it is on CLOCK_MONOTONIC (see timestampOnMonotonicClock),
+  // else the dequeue time.
+  int64_t timestamp_ns = 0;
   uint32_t sequence = 0;      // driver frame counter (gaps = frames the driver dropped)
 };
+
+// What a node's driver did, counted over the capture's life (reopens included).
+struct V4l2CaptureCounters {
+  uint64_t buffers = 0;              // buffers delivered to the caller
+  uint64_t error_buffers = 0;        // flagged V4L2_BUF_FLAG_ERROR: given back unread
+  uint64_t dequeue_time_stamps = 0;  // delivered with the dequeue time (their own was off the clock)
+};
+
+// A buffer timestamp is used as the frame's time only when it can be on CLOCK_MONOTONIC: not in
+// the future and at most kMaxBufferAgeNs old at dequeue. The V4L2 flag alone is not enough: vivid's
+// "Wrap Timestamp" flags MONOTONIC stamps that are far off that clock, and v4l2loopback stamps with
+// ktime_get_ts64 (monotonic) but flags the clock unknown. Two nodes of one camera stamped this way
+// can be paired by their kernel times.
+constexpr int64_t kMaxBufferAgeNs = 2'000'000'000;
+bool timestampOnMonotonicClock(int64_t timestamp_ns, int64_t now_ns);
 
 class V4l2Capture {
  public:
@@ -56,6 +75,9 @@ class V4l2Capture {
   void close();      // best effort, never fails: also used after the device vanished
   bool isOpen() const { return fd_ >= 0; }
   const V4l2CaptureOptions& options() const { return options_; }
+  // The format the driver streams (options().format, or kY16 standing in for kZ16).
+  V4l2PixelFormat format() const { return format_; }
+  const V4l2CaptureCounters& counters() const { return counters_; }
 
  private:
   struct MappedBuffer {
@@ -69,6 +91,8 @@ class V4l2Capture {
   V4l2CaptureOptions options_;
   int fd_ = -1;
   bool streaming_ = false;
+  V4l2PixelFormat format_ = V4l2PixelFormat::kYuyv;
+  V4l2CaptureCounters counters_;
   std::size_t stride_ = 0;
   FixedVector<MappedBuffer, kMaxBuffers> buffers_;
   int dequeued_index_ = -1;  // buffer held by the caller, -1 = none

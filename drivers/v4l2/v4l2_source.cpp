@@ -15,8 +15,9 @@ Status V4l2Source::open(const V4l2SourceOptions& options, const PinholeCamera& c
                         V4l2Device& device, std::unique_ptr<V4l2Source>* out) {
   const std::string problem = camera.validate();
   if (!problem.empty()) return Status::Error("v4l2:" + options.colour_device + ": camera invalid: " + problem);
-  if (options.colour_format == V4l2PixelFormat::kZ16)
-    return Status::Error("v4l2:" + options.colour_device + ": z16 is a depth format, not colour");
+  if (options.colour_format == V4l2PixelFormat::kZ16 || options.colour_format == V4l2PixelFormat::kY16)
+    return Status::Error("v4l2:" + options.colour_device + ": " + pixelFormatName(options.colour_format) +
+                         " is a depth format, not colour");
   std::unique_ptr<V4l2Source> source(new V4l2Source(device));
   source->options_ = options;
   source->camera_ = camera;
@@ -48,6 +49,19 @@ Status V4l2Source::openNodes() {
     }
   }
   return Status::Ok();
+}
+
+std::string V4l2Source::healthReport() const {
+  const V4l2CaptureCounters& c = colour_.counters();
+  const V4l2CaptureCounters& d = depth_.counters();
+  std::string text = "v4l2: pairs " + std::to_string(stats_.pairs) + ", unpaired colour " +
+                     std::to_string(stats_.unpaired_colour) + ", unpaired depth " +
+                     std::to_string(stats_.unpaired_depth) + ", undecodable " + std::to_string(stats_.undecodable) +
+                     ", error buffers " + std::to_string(c.error_buffers + d.error_buffers) +
+                     ", dequeue-time stamps " + std::to_string(c.dequeue_time_stamps + d.dequeue_time_stamps);
+  if (!options_.depth_device.empty() && depth_.isOpen())
+    text += std::string(", depth format ") + pixelFormatName(depth_.format());
+  return text;
 }
 
 std::string V4l2Source::describe() const {
@@ -137,6 +151,7 @@ bool V4l2Source::convert(RgbdImage& out) {
       if (!mjpegToBgr(c.data, c.bytes_used, w, h, out.bgr)) return false;
       break;
     case V4l2PixelFormat::kZ16:
+    case V4l2PixelFormat::kY16:
       return false;
   }
   if (options_.depth_device.empty()) {
@@ -154,8 +169,11 @@ bool V4l2Source::convert(RgbdImage& out) {
     const double period_ns = 1e9 / options_.fps;
     step = static_cast<uint64_t>(
         std::max(1.0, std::round((c.timestamp_ns - last_timestamp_ns_) / period_ns)));
-  } else if (have_last_ && c.sequence > last_driver_sequence_) {
-    step = c.sequence - last_driver_sequence_;
+  } else if (have_last_) {
+    // Modulo 2^32: the driver's counter wraps (vivid's "Wrap Sequence Number" tests exactly that).
+    // A step of 0 or one that looks backwards (over half the range) is a restarted counter.
+    const uint32_t driver_step = c.sequence - last_driver_sequence_;
+    if (driver_step > 0 && driver_step < 0x80000000u) step = driver_step;
   }
   out.sequence = have_last_ ? last_sequence_ + step : 0;
   have_last_ = true;

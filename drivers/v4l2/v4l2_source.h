@@ -3,9 +3,11 @@
 // (Z16, as RealSense-class cameras expose depth over UVC) by timestamp. Without a depth node the
 // depth image is all zeros ("no reading") and the source says so in describe().
 //
-// Pairing: hold the newest buffer of each node; when their timestamps differ by more than
-// max_pair_dt_ns, give back the older one and take the next from that node. Unpaired frames are
-// counted. V4L2 reports no intrinsics, so the camera comes from a camera file or preset.
+// Pairing: by the buffers' kernel timestamps (CLOCK_MONOTONIC, checked per buffer: see
+// timestampOnMonotonicClock). Hold one buffer of each node; when their timestamps differ by more
+// than max_pair_dt_ns, give back the older one and take the next from that node. Unpaired frames
+// are counted. Depth may come as Z16 or Y16 (same layout). V4L2 reports no intrinsics, so the
+// camera comes from a camera file or preset.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -47,6 +49,9 @@ class V4l2Source : public FrameSource {
   const Status& lastError() const override { return error_; }
   Status reopen() override;
   bool isLive() const override { return true; }
+  // "v4l2: pairs N, unpaired colour N, unpaired depth N, undecodable N, error buffers N,
+  // dequeue-time stamps N[, depth format z16|y16]".
+  std::string healthReport() const override;
 
   const V4l2PairingStats& pairingStats() const { return stats_; }
 

@@ -1,0 +1,305 @@
+// plumb_vmcam_feeder: plays a recording into two v4l2loopback devices the way a UVC depth camera
+// presents itself (colour as YUYV, depth as 16-bit millimetres), for the virtual-machine camera
+// bench (scripts/vm_camera_test.sh, docs/DRIVERS.md "The virtual-machine camera bench").
+//
+//   plumb_vmcam_feeder feed --source SPEC --colour DEV --depth DEV --out-dir DIR
+//                           [--fps F (10)] [--frames N (all)]
+//   plumb_vmcam_feeder match --sent DIR/sent.txt --trajectory TRAJ
+//
+// feed: frame by frame, paced at F Hz, converts colour to YUYV (BT.601 limited range) and depth to
+// millimetres, and write()s them to the loopback output nodes (v4l2loopback stamps each write with
+// CLOCK_MONOTONIC). Depth goes out as V4L2_PIX_FMT_Y16 because v4l2loopback 0.12 does not list
+// Z16; both are 16-bit little-endian, and plumb's depth node accepts either. It also writes, in DIR:
+//   replay.plumbrec  the frames exactly as plumb decodes them (YUYV -> BGR, depth in mm), stamped
+//                    with the time of their write: "a replay of the same frames";
+//   groundtruth.txt  the scene's true poses at those stamps (synthetic sources);
+//   camera.txt       the source's intrinsics with depth_factor 1000 (millimetres);
+//   sent.txt         `index t_colour t_depth` per frame written (CLOCK_MONOTONIC seconds).
+// match: which sent frame the trajectory starts at, and how many sent frames after it have no
+// trajectory line (lost on the way). Prints `first_frame K live_frames M sent_from_first S lost L`.
+#include <fcntl.h>
+#include <linux/videodev2.h>
+#include <sys/ioctl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "drivers/dataset/camera_file.h"
+#include "drivers/open/open_source.h"
+#include "drivers/recording/recording_writer.h"
+#include "drivers/synth/synth_spec.h"
+#include "drivers/trajectory/trajectory_io.h"
+#include "drivers/v4l2/pixel_formats.h"
+
+namespace {
+
+using plumb::Status;
+
+int64_t monotonicNs() {
+  timespec t{};
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return int64_t(t.tv_sec) * 1000000000 + t.tv_nsec;
+}
+
+uint8_t clampByte(int v) { return uint8_t(std::clamp(v, 0, 255)); }
+
+// BGR -> YUYV, BT.601 limited range (the encoding UVC cameras use); chroma from the pixel pair's mean.
+void bgrToYuyv(const cv::Mat& bgr, std::vector<uint8_t>* yuyv) {
+  yuyv->resize(std::size_t(bgr.cols) * bgr.rows * 2);
+  uint8_t* out = yuyv->data();
+  for (int r = 0; r < bgr.rows; ++r) {
+    const uint8_t* in = bgr.ptr<uint8_t>(r);
+    for (int c = 0; c + 1 < bgr.cols; c += 2, in += 6, out += 4) {
+      const int b0 = in[0], g0 = in[1], r0 = in[2], b1 = in[3], g1 = in[4], r1 = in[5];
+      out[0] = clampByte(((66 * r0 + 129 * g0 + 25 * b0 + 128) >> 8) + 16);
+      out[2] = clampByte(((66 * r1 + 129 * g1 + 25 * b1 + 128) >> 8) + 16);
+      const int rm = (r0 + r1 + 1) / 2, gm = (g0 + g1 + 1) / 2, bm = (b0 + b1 + 1) / 2;
+      out[1] = clampByte(((-38 * rm - 74 * gm + 112 * bm + 128) >> 8) + 128);
+      out[3] = clampByte(((112 * rm - 94 * gm - 18 * bm + 128) >> 8) + 128);
+    }
+  }
+}
+
+// Raw depth in `depth_factor` units per metre -> millimetres (what a RealSense sends as Z16).
+void depthToMillimetres(const cv::Mat& depth_raw, double depth_factor, cv::Mat* mm) {
+  mm->create(depth_raw.rows, depth_raw.cols, CV_16UC1);
+  const double scale = 1000.0 / depth_factor;
+  for (int r = 0; r < depth_raw.rows; ++r) {
+    const uint16_t* in = depth_raw.ptr<uint16_t>(r);
+    uint16_t* out = mm->ptr<uint16_t>(r);
+    for (int c = 0; c < depth_raw.cols; ++c) out[c] = uint16_t(std::min(65535.0, std::round(in[c] * scale)));
+  }
+}
+
+Status openOutput(const std::string& path, uint32_t fourcc, int width, int height, int bytes_per_pixel, int* fd) {
+  *fd = open(path.c_str(), O_RDWR | O_CLOEXEC);
+  if (*fd < 0) return Status::Error(path + ": open failed: " + std::strerror(errno));
+  v4l2_format fmt{};
+  fmt.type = V4L2_BUF_TYPE_VIDEO_OUTPUT;
+  fmt.fmt.pix.width = uint32_t(width);
+  fmt.fmt.pix.height = uint32_t(height);
+  fmt.fmt.pix.pixelformat = fourcc;
+  fmt.fmt.pix.field = V4L2_FIELD_NONE;
+  fmt.fmt.pix.bytesperline = uint32_t(width * bytes_per_pixel);
+  fmt.fmt.pix.sizeimage = uint32_t(width * height * bytes_per_pixel);
+  fmt.fmt.pix.colorspace = V4L2_COLORSPACE_SMPTE170M;
+  if (ioctl(*fd, VIDIOC_S_FMT, &fmt) != 0)
+    return Status::Error(path + ": VIDIOC_S_FMT (output) failed: " + std::strerror(errno));
+  if (fmt.fmt.pix.pixelformat != fourcc || int(fmt.fmt.pix.width) != width || int(fmt.fmt.pix.height) != height)
+    return Status::Error(path + ": the loopback device refused the output format");
+  return Status::Ok();
+}
+
+// One write() of a whole frame; returns the middle of the call on CLOCK_MONOTONIC (the driver
+// stamps the buffer inside it).
+Status writeFrame(int fd, const std::string& path, const void* data, std::size_t size, int64_t* stamp_ns) {
+  const int64_t before = monotonicNs();
+  const ssize_t n = write(fd, data, size);
+  const int64_t after = monotonicNs();
+  if (n != ssize_t(size))
+    return Status::Error(path + ": write of " + std::to_string(size) + " bytes returned " + std::to_string(n) +
+                         (n < 0 ? std::string(": ") + std::strerror(errno) : std::string()));
+  *stamp_ns = before + (after - before) / 2;
+  return Status::Ok();
+}
+
+struct FeedOptions {
+  std::string source, colour, depth, out_dir;
+  double fps = 10;
+  long frames = -1;
+};
+
+int feed(const FeedOptions& o) {
+  std::unique_ptr<plumb::FrameSource> source;
+  std::unique_ptr<plumb::SyntheticSource> synth;
+  Status st;
+  if (plumb::isSynthSpec(o.source)) {
+    st = plumb::openSynthSpec(o.source, false, &synth);
+  } else {
+    st = plumb::openFrameSource(o.source, "", &source);
+  }
+  if (!st.ok()) {
+    std::fprintf(stderr, "feeder: %s\n", st.message().c_str());
+    return 1;
+  }
+  plumb::FrameSource& frames = synth ? *synth : *source;
+  plumb::PinholeCamera camera = frames.camera();
+  camera.depth_factor = 1000.0;
+  int colour_fd = -1, depth_fd = -1;
+  st = openOutput(o.colour, V4L2_PIX_FMT_YUYV, camera.width, camera.height, 2, &colour_fd);
+  if (st.ok()) st = openOutput(o.depth, V4L2_PIX_FMT_Y16, camera.width, camera.height, 2, &depth_fd);
+  if (st.ok()) st = plumb::writeCameraFile(o.out_dir + "/camera.txt", camera);
+  std::unique_ptr<plumb::RecordingWriter> replay;
+  plumb::RecordingWriterOptions writer_options;
+  writer_options.colour_codec = writer_options.depth_codec = plumb::ImageCodec::kRaw;
+  writer_options.fsync = plumb::FsyncPolicy::kNever;
+  if (st.ok()) st = plumb::RecordingWriter::open(o.out_dir + "/replay.plumbrec", camera, writer_options, &replay);
+  if (!st.ok()) {
+    std::fprintf(stderr, "feeder: %s\n", st.message().c_str());
+    return 1;
+  }
+  std::FILE* sent = std::fopen((o.out_dir + "/sent.txt").c_str(), "w");
+  if (!sent) {
+    std::fprintf(stderr, "feeder: cannot write %s/sent.txt\n", o.out_dir.c_str());
+    return 1;
+  }
+  std::fprintf(sent, "# index t_colour t_depth (CLOCK_MONOTONIC s, middle of the write() call)\n");
+  const int64_t period_ns = int64_t(1e9 / o.fps);
+  plumb::RgbdImage in, decoded;
+  std::vector<uint8_t> yuyv;
+  std::vector<plumb::StampedPose> truth;
+  std::vector<plumb::StampedPose> scene_truth;
+  if (synth) scene_truth = plumb::syntheticGroundTruth(synth->scene(), long(synth->frameCount()));
+  int64_t due_ns = monotonicNs();
+  long index = 0;
+  double render_ms = 0;
+  for (; o.frames < 0 || index < o.frames; ++index) {
+    const int64_t render_start = monotonicNs();
+    const plumb::SourceResult r = frames.next(in);
+    if (r == plumb::SourceResult::kEndOfStream) break;
+    if (r != plumb::SourceResult::kFrame) {
+      std::fprintf(stderr, "feeder: source: %s\n", frames.lastError().message().c_str());
+      return 1;
+    }
+    bgrToYuyv(in.bgr, &yuyv);
+    plumb::yuyvToBgr(yuyv.data(), camera.width, camera.height, std::size_t(camera.width) * 2, decoded.bgr);
+    depthToMillimetres(in.depth_raw, in.depth_factor, &decoded.depth_raw);
+    render_ms += (monotonicNs() - render_start) * 1e-6;
+    // Absolute schedule: a slow frame is sent at once and the next ones catch up, no drift.
+    timespec due{time_t(due_ns / 1000000000), long(due_ns % 1000000000)};
+    clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &due, nullptr);
+    due_ns = std::max(due_ns + period_ns, monotonicNs());
+    int64_t t_colour = 0, t_depth = 0;
+    st = writeFrame(colour_fd, o.colour, yuyv.data(), yuyv.size(), &t_colour);
+    if (st.ok()) st = writeFrame(depth_fd, o.depth, decoded.depth_raw.data, decoded.depth_raw.total() * 2, &t_depth);
+    if (!st.ok()) {
+      std::fprintf(stderr, "feeder: %s\n", st.message().c_str());
+      return 1;
+    }
+    std::fprintf(sent, "%ld %.6f %.6f\n", index, t_colour * 1e-9, t_depth * 1e-9);
+    decoded.sequence = uint64_t(index);
+    decoded.timestamp_s = t_colour * 1e-9;
+    decoded.depth_timestamp_s = t_depth * 1e-9;
+    decoded.t_sensor_ns = t_colour;
+    decoded.depth_factor = 1000.0;
+    st = replay->append(decoded);
+    if (!st.ok()) {
+      std::fprintf(stderr, "feeder: %s\n", st.message().c_str());
+      return 1;
+    }
+    if (std::size_t(index) < scene_truth.size()) {
+      plumb::StampedPose pose = scene_truth[std::size_t(index)];
+      pose.timestamp = t_colour * 1e-9;
+      truth.push_back(pose);
+    }
+  }
+  std::fclose(sent);
+  close(colour_fd);
+  close(depth_fd);
+  st = replay->close();
+  if (st.ok() && !truth.empty()) st = plumb::writeTumTrajectory(o.out_dir + "/groundtruth.txt", truth);
+  if (!st.ok()) {
+    std::fprintf(stderr, "feeder: %s\n", st.message().c_str());
+    return 1;
+  }
+  std::printf("feeder: wrote %ld frames at %.1f Hz (render + convert %.1f ms/frame)\n", index, o.fps,
+              index ? render_ms / double(index) : 0.0);
+  return 0;
+}
+
+// Timestamps of a trajectory file, one per input frame: pose lines and `# <t> lost|dropped` markers.
+std::vector<double> trajectoryStamps(const std::string& path) {
+  std::vector<double> stamps;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream fields(line);
+    std::string first;
+    fields >> first;
+    if (first.empty()) continue;
+    if (first == "#") {
+      std::string t, what;
+      fields >> t >> what;
+      if (what == "lost" || what == "dropped") stamps.push_back(std::atof(t.c_str()));
+      continue;
+    }
+    stamps.push_back(std::atof(first.c_str()));
+  }
+  return stamps;
+}
+
+int match(const std::string& sent_path, const std::string& trajectory_path) {
+  std::vector<double> sent;
+  std::ifstream in(sent_path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    long index = 0;
+    double t_colour = 0, t_depth = 0;
+    if (std::sscanf(line.c_str(), "%ld %lf %lf", &index, &t_colour, &t_depth) == 3) sent.push_back(t_colour);
+  }
+  const std::vector<double> live = trajectoryStamps(trajectory_path);
+  if (sent.empty() || live.empty()) {
+    std::fprintf(stderr, "match: %s has %zu frames, %s %zu\n", sent_path.c_str(), sent.size(),
+                 trajectory_path.c_str(), live.size());
+    return 1;
+  }
+  // Every live stamp must be one sent frame's (the driver stamps inside the write: < 5 ms apart).
+  std::size_t first = sent.size(), matched = 0, unmatched = 0;
+  for (double t : live) {
+    const auto it = std::min_element(sent.begin(), sent.end(),
+                                     [t](double a, double b) { return std::fabs(a - t) < std::fabs(b - t); });
+    if (std::fabs(*it - t) > 0.005) {
+      ++unmatched;
+      continue;
+    }
+    ++matched;
+    first = std::min(first, std::size_t(it - sent.begin()));
+  }
+  const std::size_t sent_from_first = first < sent.size() ? sent.size() - first : 0;
+  std::printf("first_frame %zu live_frames %zu matched %zu unmatched %zu sent_from_first %zu lost %ld\n", first,
+              live.size(), matched, unmatched, sent_from_first, long(sent_from_first) - long(matched));
+  return unmatched == 0 ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string command = argc > 1 ? argv[1] : "";
+  FeedOptions feed_options;
+  std::string sent, trajectory;
+  for (int i = 2; i + 1 < argc; i += 2) {
+    const std::string key = argv[i], value = argv[i + 1];
+    if (key == "--source") feed_options.source = value;
+    else if (key == "--colour") feed_options.colour = value;
+    else if (key == "--depth") feed_options.depth = value;
+    else if (key == "--out-dir") feed_options.out_dir = value;
+    else if (key == "--fps") feed_options.fps = std::atof(value.c_str());
+    else if (key == "--frames") feed_options.frames = std::atol(value.c_str());
+    else if (key == "--sent") sent = value;
+    else if (key == "--trajectory") trajectory = value;
+    else {
+      std::fprintf(stderr, "feeder: unknown option %s\n", key.c_str());
+      return 2;
+    }
+  }
+  if (command == "feed" && !feed_options.source.empty() && !feed_options.colour.empty() &&
+      !feed_options.depth.empty() && !feed_options.out_dir.empty() && feed_options.fps > 0)
+    return feed(feed_options);
+  if (command == "match" && !sent.empty() && !trajectory.empty()) return match(sent, trajectory);
+  std::fprintf(stderr,
+               "usage: %s feed --source SPEC --colour DEV --depth DEV --out-dir DIR [--fps F] [--frames N]\n"
+               "       %s match --sent FILE --trajectory FILE\n",
+               argv[0], argv[0]);
+  return 2;
+}
