@@ -15,7 +15,7 @@ exec >/dev/console 2>&1
 param() { tr ' ' '\n' </proc/cmdline | sed -n "s/^vmcam\.$1=//p"; }
 ACCEL=$(param accel)
 FPS=$(param fps)
-FRAMES=$(param frames)
+ONLY=$(param only)
 failures=0
 say() { echo "VMCAM $*"; }
 ok() { say "  ok   $*"; }
@@ -26,13 +26,15 @@ now() { cut -d' ' -f1 /proc/uptime; }
 since() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.1f", b - a }'; }
 # field "TEXT" "NAME": the number after NAME in TEXT ("reconnects 1" -> 1).
 field() { echo "$1" | grep -o "$2 [0-9.]*" | head -1 | awk '{ print $NF }'; }
+# before "TEXT" "NAME": the number before NAME ("5 failed reopens" -> 5).
+before() { echo "$1" | grep -o "[0-9.]* $2" | head -1 | awk '{ print $1 }'; }
 finish() {
   say "EXIT $failures"
   sync
   poweroff -f
 }
 
-say "guest: kernel $(uname -r), accelerator $ACCEL, $(grep -c ^processor /proc/cpuinfo) CPUs, fps $FPS, frames $FRAMES"
+say "guest: kernel $(uname -r), accelerator $ACCEL, $(grep -c ^processor /proc/cpuinfo) CPUs, fps $FPS, checks: $ONLY"
 
 # ============================================================================================
 # 1. vivid: a real V4L2 capture driver, and every error-injection control it offers
@@ -62,33 +64,30 @@ vivid_check() {
     --frames 1 >/tmp/refused.txt 2>&1
   check "500x400 refused: $(cat /tmp/refused.txt)" grep -q "asked for yuyv 500x400, driver offers" /tmp/refused.txt
 
-  # Capture with every fault vivid can inject, one after the other, while plumb records.
-  ctl "Wrap Sequence Number" 1
-  ctl "Wrap Timestamp" 1
+  # Capture while every control vivid 6.1 offers for faults is pulled, one after the other.
   plumb record --source v4l2:/dev/video0 --camera /tmp/vivid_camera.txt --out /tmp/vivid.plumbrec \
     --codec raw >/tmp/vivid_record.txt 2>&1 &
   rec=$!
-  sleep 2
-  ctl "Inject V4L2_BUF_FLAG_ERROR" 1
-  sleep 0.5
-  ctl "Inject EOS Event" 1
-  ctl "Inject Source Change Event" 1
+  sleep 1
+  ctl "Wrap Sequence Number" 1              # from the next STREAMON: the counter starts below 2^32
+  ctl "Wrap Timestamp" 1                    # from the next STREAMON: stamps far off CLOCK_MONOTONIC
+  sleep 1
+  ctl "Inject V4L2_BUF_FLAG_ERROR" 1        # one buffer comes back flagged damaged
+  ctl "Inject req_validate() Error" 1       # media requests: plumb uses none, so no effect
   ctl "Percentage of Dropped Buffers" 30
   sleep 1
   ctl "Percentage of Dropped Buffers" 0
   sleep 0.5
-  ctl "Inject VIDIOC_STREAMON Error" 1      # armed: the reopen after the next fault fails once
-  ctl "Inject Fatal Streaming Error" 1
+  ctl "Inject VIDIOC_QBUF Error" 1          # the next requeue fails
   sleep 1.5
-  ctl "Inject VIDIOC_PREPARE_BUF Error" 1
-  sleep 1.5
-  ctl "Disconnect" 1                        # the node goes away like an unplugged camera
-  t_gone=$(now)
-  sleep 1
-  i=0
-  while ! rmmod vivid 2>/dev/null && [ $i -lt 50 ]; do sleep 0.1; i=$((i + 1)); done
-  load_vivid || bad "vivid reloaded"
-  sleep 2.5
+  ctl "Inject VIDIOC_REQBUFS Error" 1       # armed: the next reopen fails at REQBUFS ...
+  ctl "Inject VIDIOC_STREAMON Error" 1      # ... and the one after at STREAMON
+  ctl "Inject Fatal Streaming Error" 1      # the queue fails now (DQBUF: EIO)
+  sleep 2
+  # The node goes away like an unplugged camera; vivid registers it again once its last user has
+  # closed it (plumb does, on the error), as a replugged camera comes back.
+  ctl "Disconnect" 1
+  sleep 3
   kill -INT $rec
   wait $rec
   status=$?
@@ -96,13 +95,15 @@ vivid_check() {
   health=$(grep '^source:' /tmp/vivid_record.txt)
   frames=$(grep -o 'recorded [0-9]* frames' /tmp/vivid_record.txt | awk '{ print $2 }')
   check "plumb record survived every fault and stopped cleanly (exit $status, $frames frames)" [ "$status" -eq 0 ]
-  say "  faults counted: errors $(field "$health" errors), reconnects $(field "$health" reconnects) ($(field "$health" "reconnects [0-9]* (") s disconnected), failed reopens $(field "$health" "disconnected, ")"
-  say "  driver: error buffers $(field "$health" "error buffers"), frames missing $(field "$health" "frames missing") in $(field "$health" "in") gaps, dequeue-time stamps $(field "$health" "dequeue-time stamps")"
+  say "  faults counted: errors $(field "$health" errors), reconnects $(field "$health" reconnects) ($(before "$health" "s disconnected") s disconnected), failed reopens $(before "$health" "failed reopens")"
+  say "  driver: error buffers $(field "$health" "error buffers"), frames missing $(field "$health" "frames missing") in $(before "$health" gaps) gaps, dequeue-time stamps $(field "$health" "dequeue-time stamps")"
   check "the flagged buffer was dropped and counted" [ "$(field "$health" "error buffers")" -ge 1 ]
   check "dropped buffers counted as missing frames" [ "$(field "$health" "frames missing")" -ge 1 ]
-  check "streaming error, STREAMON error, PREPARE_BUF error and disconnect each recovered" \
+  check "QBUF error, fatal streaming error (+ REQBUFS and STREAMON errors on reopen) and disconnect recovered" \
     [ "$(field "$health" reconnects)" -ge 3 ]
-  check "wrapped timestamps replaced by the dequeue time" [ "$(field "$health" "dequeue-time stamps")" -ge 1 ]
+  check "the REQBUFS and STREAMON errors failed a reopen each" [ "$(before "$health" "failed reopens")" -ge 2 ]
+  check "wrapped timestamps replaced by the dequeue time, kernel stamps used otherwise" \
+    [ "$(field "$health" "dequeue-time stamps")" -ge 1 ] && [ "$(field "$health" "dequeue-time stamps")" -lt "${frames:-0}" ]
   check "frames kept coming after the reload" [ "${frames:-0}" -ge 100 ]
   say "  vivid took $(since "$t0") s"
 }
@@ -117,12 +118,15 @@ loopback_check() {
     card_label="plumb colour,plumb depth" || { bad "modprobe v4l2loopback"; return; }
   d=/tmp/loop
   mkdir -p $d
-  plumb_vmcam_feeder feed --source "synth:textured:1:$FRAMES" --colour /dev/video10 --depth /dev/video11 \
+  plumb_vmcam_feeder feed --source /vmcam/synth --colour /dev/video10 --depth /dev/video11 \
     --out-dir $d --fps "$FPS" >$d/feeder.log 2>&1 &
   feeder=$!
   # The capture side exists once the feeder has written a frame (exclusive_caps).
   i=0
-  while [ "$(grep -vc '^#' $d/sent.txt 2>/dev/null)" -lt 1 ] && [ $i -lt 100 ]; do sleep 0.1; i=$((i + 1)); done
+  while [ "$(grep -vc '^#' $d/sent.txt 2>/dev/null || echo 0)" -lt 1 ] && [ $i -lt 1200 ]; do
+    sleep 0.1
+    i=$((i + 1))
+  done
   plumb run --dataset v4l2:/dev/video10,/dev/video11 --camera $d/camera.txt --out $d/live.txt \
     >$d/live.log 2>&1 &
   live=$!
@@ -161,11 +165,14 @@ loopback_check() {
 # ============================================================================================
 # 3. USB: a gadget with a depth camera's identity on dummy_hcd, libusb discovery and hot-plug
 # ============================================================================================
-GADGET=/sys/kernel/config/usb_gadget/vmcam
-make_uvc_gadget() {
-  g=$GADGET
+CONFIGFS=/sys/kernel/config/usb_gadget
+# make_gadget NAME FUNCTION: a gadget with a RealSense D435's identity (drivers/usb/usb_camera_table.cpp)
+# and one function: uvc (a UVC camera: control + streaming interfaces, YUYV 320x240 at 15 Hz) or
+# sourcesink (bulk interfaces, for controllers UVC cannot bind to).
+make_gadget() {
+  g=$CONFIGFS/$1
   mkdir $g || return 1
-  echo 0x8086 >$g/idVendor              # Intel RealSense D435 (drivers/usb/usb_camera_table.cpp)
+  echo 0x8086 >$g/idVendor
   echo 0x0b07 >$g/idProduct
   echo 0x0200 >$g/bcdUSB
   echo 0xEF >$g/bDeviceClass            # miscellaneous / interface association, as UVC cameras
@@ -178,67 +185,151 @@ make_uvc_gadget() {
   mkdir $g/configs/c.1 $g/configs/c.1/strings/0x409
   echo "video" >$g/configs/c.1/strings/0x409/configuration
   echo 500 >$g/configs/c.1/MaxPower
-  f=$g/functions/uvc.0
-  mkdir $f || return 1
-  mkdir -p $f/control/header/h
-  ln -s $f/control/header/h $f/control/class/fs/h
-  ln -s $f/control/header/h $f/control/class/ss/h
-  mkdir -p $f/streaming/uncompressed/u/480p
-  echo 640 >$f/streaming/uncompressed/u/480p/wWidth
-  echo 480 >$f/streaming/uncompressed/u/480p/wHeight
-  echo $((640 * 480 * 2)) >$f/streaming/uncompressed/u/480p/dwMaxVideoFrameBufferSize
-  echo 333333 >$f/streaming/uncompressed/u/480p/dwDefaultFrameInterval
-  printf '333333\n' >$f/streaming/uncompressed/u/480p/dwFrameInterval
-  mkdir $f/streaming/header/h
-  ln -s $f/streaming/uncompressed/u $f/streaming/header/h/u
-  ln -s $f/streaming/header/h $f/streaming/class/fs/h
-  ln -s $f/streaming/header/h $f/streaming/class/hs/h
-  ln -s $f/streaming/header/h $f/streaming/class/ss/h
+  if [ "$2" = uvc ]; then
+    f=$g/functions/uvc.0
+    mkdir $f || return 1
+    mkdir -p $f/control/header/h
+    ln -s $f/control/header/h $f/control/class/fs/h
+    ln -s $f/control/header/h $f/control/class/ss/h
+    echo 3072 >$f/streaming_maxpacket      # 3 x 1024 bytes per microframe (high speed)
+    fr=$f/streaming/uncompressed/u/240p
+    mkdir -p $fr
+    echo 320 >$fr/wWidth
+    echo 240 >$fr/wHeight
+    echo $((320 * 240 * 2)) >$fr/dwMaxVideoFrameBufferSize
+    echo 666666 >$fr/dwDefaultFrameInterval
+    echo 666666 >$fr/dwFrameInterval
+    mkdir $f/streaming/header/h
+    ln -s $f/streaming/uncompressed/u $f/streaming/header/h/u
+    for speed in fs hs ss; do ln -s $f/streaming/header/h $f/streaming/class/$speed/h; done
+  else
+    f=$g/functions/SourceSink.0
+    mkdir $f || return 1
+  fi
   ln -s $f $g/configs/c.1/
+}
+
+# wait_camera present|absent: until a USB device 8086:0b07 is (not) enumerated, at most 30 s.
+wait_camera() {
+  i=0
+  while [ $i -lt 150 ]; do
+    if grep -qs 0b07 /sys/bus/usb/devices/*/idProduct; then found=present; else found=absent; fi
+    [ $found = "$1" ] && return 0
+    sleep 0.2
+    i=$((i + 1))
+  done
+  return 1
+}
+
+# The uvcvideo capture node of the gadget camera (its V4L2 name is the product string).
+uvc_capture_node() {
+  for n in /sys/class/video4linux/video*; do
+    if grep -q "RealSense" $n/name 2>/dev/null && [ "$(cat $n/index 2>/dev/null)" = 0 ]; then
+      echo /dev/$(basename $n)
+      return
+    fi
+  done
+}
+# The gadget side's video output node (usb_f_uvc names it after the UDC).
+uvc_gadget_node() {
+  for n in /sys/class/video4linux/video*; do
+    grep -qE "udc|vudc" $n/name 2>/dev/null && { echo /dev/$(basename $n); return; }
+  done
 }
 
 usb_check() {
   t0=$(now)
   say "usb:"
-  modprobe dummy_hcd && modprobe libcomposite && modprobe usb_f_uvc && modprobe uvcvideo ||
-    { bad "modprobe dummy_hcd libcomposite usb_f_uvc uvcvideo"; return; }
+  modprobe dummy_hcd && modprobe libcomposite && modprobe usb_f_uvc && modprobe usb_f_ss_lb &&
+    modprobe uvcvideo || { bad "modprobe dummy_hcd libcomposite usb_f_uvc usb_f_ss_lb uvcvideo"; return; }
   mount -t configfs none /sys/kernel/config 2>/dev/null
-  check "UVC gadget with a RealSense D435's identity created through configfs" make_uvc_gadget
-  udc=$(ls /sys/class/udc | head -1)
-  echo "$udc" >$GADGET/UDC
-  sleep 1.5
-  say "  usb_f_uvc options (no bulk-streaming option in this kernel): $(ls $GADGET/functions/uvc.0 | tr '\n' ' ')"
+
+  # (a) Discovery and hot-plug on dummy_hcd, with the same identity over bulk interfaces.
+  make_gadget camera sourcesink || { bad "gadget created through configfs"; return; }
+  t_bind=$(now)
+  echo dummy_udc.0 >$CONFIGFS/camera/UDC
+  wait_camera present || bad "the gadget enumerated on dummy_hcd"
+  say "  enumerated on dummy_hcd after $(since "$t_bind") s"
+  dmesg | grep -E 'usb 1-1' | tail -5
   plumb devices >/tmp/devices.txt 2>&1
   cat /tmp/devices.txt
   check "plumb devices finds the camera through libusb: $(grep '8086:0b07' /tmp/devices.txt | head -1)" \
     grep -q "usb: 8086:0b07 Intel RealSense D435 at usb" /tmp/devices.txt
-  uvc_node=""
-  for n in /sys/class/video4linux/video*; do
-    grep -q "RealSense" $n/name 2>/dev/null && [ -z "$uvc_node" ] && uvc_node=/dev/$(basename $n)
-  done
-  say "  uvcvideo bound the gadget: ${uvc_node:-no capture node} ($(dmesg | grep -m1 'uvcvideo.*Found UVC' | sed 's/^\[[^]]*\] //'))"
-
-  # Hot-plug: the camera leaves (UDC unbound) and comes back 2 s later.
-  plumb devices --watch 9 >/tmp/watch.txt 2>&1 &
+  plumb devices --watch 12 >/tmp/watch.txt 2>&1 &
   watch=$!
   sleep 2
-  echo "" >$GADGET/UDC
+  echo "" >$CONFIGFS/camera/UDC
   t_unplug=$(now)
   sleep 2
-  echo "$udc" >$GADGET/UDC
+  echo dummy_udc.0 >$CONFIGFS/camera/UDC
   t_replug=$(now)
+  wait_camera present
+  sleep 1
+  kill -INT $watch
   wait $watch
   cat /tmp/watch.txt
   check "the departure was reported" grep -q "usb: left 8086:0b07" /tmp/watch.txt
   check "the arrival was reported" grep -q "usb: arrived 8086:0b07" /tmp/watch.txt
   t_left=$(grep -m1 "usb: left 8086:0b07" /tmp/watch.txt | grep -o 'at [0-9.]* s' | awk '{ print $2 }')
   t_arrived=$(grep -m1 "usb: arrived 8086:0b07" /tmp/watch.txt | grep -o 'at [0-9.]* s' | awk '{ print $2 }')
-  say "  unplug -> departure event $(awk -v a="$t_unplug" -v b="$t_left" 'BEGIN { printf "%.3f", b - a }') s, replug -> arrival event $(awk -v a="$t_replug" -v b="$t_arrived" 'BEGIN { printf "%.3f", b - a }') s (outage $(awk -v a="$t_left" -v b="$t_arrived" 'BEGIN { printf "%.3f", b - a }') s)"
+  if [ -n "$t_left" ] && [ -n "$t_arrived" ]; then
+    say "  unplug -> departure event $(awk -v a="$t_unplug" -v b="$t_left" 'BEGIN { printf "%.3f", b - a }') s, replug -> arrival event $(awk -v a="$t_replug" -v b="$t_arrived" 'BEGIN { printf "%.3f", b - a }') s (outage seen by libusb $(awk -v a="$t_left" -v b="$t_arrived" 'BEGIN { printf "%.3f", b - a }') s)"
+  fi
+  echo "" >$CONFIGFS/camera/UDC
+
+  # (b) Can dummy_hcd carry a UVC camera? Its controller has no isochronous endpoint, and 6.1's
+  # usb_f_uvc streams only isochronously (its options have no bulk mode), so the bind fails.
+  make_gadget uvcdummy uvc || bad "UVC gadget created through configfs"
+  say "  usb_f_uvc options: $(ls $CONFIGFS/uvcdummy/functions/uvc.0 | tr '\n' ' ')"
+  echo dummy_udc.0 >$CONFIGFS/uvcdummy/UDC 2>/dev/null
+  sleep 0.5
+  if [ "$(cat $CONFIGFS/uvcdummy/UDC)" = dummy_udc.0 ]; then
+    say "  UVC gadget bound to dummy_udc.0"
+  else
+    say "  UVC gadget cannot bind to dummy_udc.0: $(dmesg | grep -m1 'Unable to allocate streaming EP' | sed 's/^\[[^]]*\] //')"
+  fi
+  echo "" >$CONFIGFS/uvcdummy/UDC 2>/dev/null  # a failed bind stays pending on the UDC otherwise
+
+  # (c) UVC video over USB/IP: the UVC gadget on usbip-vudc, attached to vhci-hcd over loopback TCP.
+  ip link set lo up
+  modprobe usbip-vudc && modprobe vhci-hcd || { bad "modprobe usbip-vudc vhci-hcd"; return; }
+  echo usbip-vudc.0 >$CONFIGFS/uvcdummy/UDC 2>/dev/null
+  sleep 0.5
+  if [ "$(cat $CONFIGFS/uvcdummy/UDC)" != usbip-vudc.0 ]; then
+    say "  UVC gadget cannot bind to usbip-vudc.0: $(dmesg | grep 'Unable to allocate streaming EP\|vudc' | tail -1 | sed 's/^\[[^]]*\] //')"
+  else
+    gadget_node=$(uvc_gadget_node)
+    plumb_vmcam_uvc_gadget --device "$gadget_node" --seconds 40 >/tmp/uvc_gadget.txt 2>&1 &
+    served=$!
+    plumb_vmcam_usbip
+    sleep 3
+    capture=$(uvc_capture_node)
+    dmesg | grep -iE 'uvc|vhci|vudc|usb 3-|usb 2-' | tail -12
+    say "  UVC over USB/IP: gadget node ${gadget_node:-none}, uvcvideo capture node ${capture:-none}"
+    if [ -n "$capture" ]; then
+      printf 'fx 262\nfy 262\ncx 159.5\ncy 119.5\nwidth 320\nheight 240\n' >/tmp/uvc_camera.txt
+      echo 0x80 >/sys/module/uvcvideo/parameters/trace  # UVC_DBG_FRAME: why frames are dropped
+      plumb record --source v4l2:$capture --camera /tmp/uvc_camera.txt --out /tmp/uvc.plumbrec --codec raw \
+        --frames 20 >/tmp/uvc_record.txt 2>&1 &
+      rec=$!
+      sleep 15
+      kill -INT $rec 2>/dev/null
+      wait $rec
+      cat /tmp/uvc_record.txt
+      mount -t debugfs none /sys/kernel/debug 2>/dev/null
+      for st in /sys/kernel/debug/usb/uvcvideo/*/stats; do say "  uvcvideo stream statistics:"; sed 's/^/VMCAM     /' $st; done
+      say "  uvcvideo frame log: $(dmesg | grep -c 'isochronous frame lost') isochronous frames lost; first lines:"
+      dmesg | grep -iE 'frame lost|Non-zero status|Dropping|payload|FID' | head -8 | sed 's/^/VMCAM     /' 
+    fi
+    kill $served 2>/dev/null
+    wait $served
+    cat /tmp/uvc_gadget.txt
+  fi
   say "  usb took $(since "$t0") s"
 }
 
 /sbin/systemd-udevd --daemon 2>/dev/null || say "  (systemd-udevd did not start: libusb hears no hot-plug events)"
-vivid_check
-loopback_check
-usb_check
+case "$ONLY" in *all*|*vivid*) vivid_check ;; esac
+case "$ONLY" in *all*|*loop*) loopback_check ;; esac
+case "$ONLY" in *all*|*usb*) usb_check ;; esac
 finish

@@ -21,6 +21,7 @@
 #   PLUMB_VM_ACCEL      kvm | tcg | auto (default auto: kvm when /dev/kvm can be opened)
 #   PLUMB_VM_CACHE      where the downloaded .deb files are kept (default BUILD_DIR/vm_camera/cache)
 #   PLUMB_VM_TIMEOUT    seconds before the guest is killed (default 480 with KVM, 1500 with TCG)
+#   PLUMB_VM_ONLY       run only some checks: any of vivid, loop, usb (default all)
 set -euo pipefail
 start_s=$(date +%s.%N)
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -45,27 +46,9 @@ done
 if [ ${#missing[@]} -gt 0 ]; then
   fail "missing ${missing[*]} (bash scripts/install_deps.sh installs them; PLUMB_VM_CAMERA=0 disables the bench)"
 fi
-for program in plumb plumb_vmcam_feeder plumb_vmcam_v4l2ctl plumb_vmcam_uvc_gadget; do
+for program in plumb plumb_vmcam_feeder plumb_vmcam_v4l2ctl plumb_vmcam_uvc_gadget plumb_vmcam_usbip; do
   [ -x "$build/bin/$program" ] || fail "$build/bin/$program not built (cmake --build $build)"
 done
-
-# --- accelerator ---------------------------------------------------------------------------------
-accel="${PLUMB_VM_ACCEL:-auto}"
-kvm_usable() {  # KVM_GET_API_VERSION (ioctl 0xAE00) answers 12 when KVM works
-  python3 - <<'EOF' 2>/dev/null
-import fcntl, os, sys
-fd = os.open("/dev/kvm", os.O_RDWR)
-sys.exit(0 if fcntl.ioctl(fd, 0xAE00) == 12 else 1)
-EOF
-}
-if [ "$accel" = "auto" ]; then
-  if kvm_usable; then accel=kvm; else accel=tcg; fi
-fi
-case "$accel" in
-  kvm) kvm_usable || fail "PLUMB_VM_ACCEL=kvm but /dev/kvm cannot be opened ($(ls -l /dev/kvm 2>&1))" ;;
-  tcg) echo "vm_camera: /dev/kvm not usable: TCG emulation, lower frame rate and fewer frames" ;;
-  *) fail "PLUMB_VM_ACCEL must be kvm, tcg or auto" ;;
-esac
 
 # --- the guest kernel: Debian's linux-image-amd64, downloaded and extracted, never installed --------
 mkdir -p "$cache" "$work"
@@ -98,6 +81,39 @@ if [ ! -f "$kroot/.extracted" ]; then
 fi
 echo "vm_camera: kernel $kver ($(elapsed "$t0") s to fetch and extract)"
 
+# --- accelerator: KVM only if it really boots this kernel ---------------------------------------
+# /dev/kvm may open and still not run a stock kernel: under PVM (kvm_pvm, a nested-virtualization
+# module of some cloud machines) a Debian kernel hangs at its first instruction. So a short boot
+# probe must print the kernel's banner before KVM is used.
+accel="${PLUMB_VM_ACCEL:-auto}"
+kvm_reason=""
+kvm_boots() {
+  if ! python3 -c 'import fcntl, os, sys; sys.exit(0 if fcntl.ioctl(os.open("/dev/kvm", os.O_RDWR), 0xAE00) == 12 else 1)' \
+      2>/dev/null; then  # 0xAE00: KVM_GET_API_VERSION, 12 when KVM works
+    kvm_reason="/dev/kvm cannot be opened ($(ls -l /dev/kvm 2>&1))"
+    return 1
+  fi
+  if [ -d /sys/module/kvm_pvm ]; then  # known not to boot stock kernels: save the 30 s probe
+    kvm_reason="this host's KVM is kvm_pvm, which runs only PVM-enabled guest kernels"
+    return 1
+  fi
+  timeout 30 qemu-system-x86_64 -enable-kvm -cpu host,-arch-capabilities -m 256 -nographic -no-reboot \
+    -kernel "$kroot/boot/vmlinuz-$kver" -append "console=ttyS0 earlyprintk=serial,ttyS0 panic=-1 init=/none" \
+    </dev/null >"$work/kvm_probe.log" 2>&1
+  if grep -q "Linux version" "$work/kvm_probe.log"; then return 0; fi
+  kvm_reason="/dev/kvm opens but $kver does not boot under it within 30 s ($work/kvm_probe.log)"
+  return 1
+}
+t0=$(date +%s.%N)
+case "$accel" in
+  auto) if kvm_boots; then accel=kvm; else accel=tcg; fi ;;
+  kvm) kvm_boots || fail "PLUMB_VM_ACCEL=kvm: $kvm_reason" ;;
+  tcg) kvm_reason="PLUMB_VM_ACCEL=tcg" ;;
+  *) fail "PLUMB_VM_ACCEL must be kvm, tcg or auto" ;;
+esac
+[ "$accel" = tcg ] && echo "vm_camera: TCG emulation (lower frame rate, fewer frames): $kvm_reason"
+echo "vm_camera: accelerator $accel ($(elapsed "$t0") s to decide)"
+
 # --- v4l2loopback, built against the guest kernel's headers --------------------------------------
 t0=$(date +%s.%N)
 loop_src=$(ls -d "$kroot"/usr/src/v4l2loopback-* | tail -1)
@@ -110,6 +126,24 @@ if [ ! -f "$loop_ko" ]; then
 fi
 echo "vm_camera: v4l2loopback $(basename "$loop_src") built for $kver ($(elapsed "$t0") s)"
 
+# --- frames for the v4l2loopback check: a synthetic scene rendered here, natively ----------------
+if [ "$accel" = kvm ]; then
+  # arch-capabilities off: some nested KVM hosts refuse its MSR (0x10a) and qemu aborts.
+  accel_flags=(-enable-kvm -cpu host,-arch-capabilities)
+  guest_fps=10 guest_frames=120 timeout_s="${PLUMB_VM_TIMEOUT:-480}"
+else
+  accel_flags=(-accel tcg -cpu max)
+  guest_fps=2 guest_frames=40 timeout_s="${PLUMB_VM_TIMEOUT:-1500}"
+fi
+t0=$(date +%s.%N)
+synth="$work/synth-$guest_frames"
+if [ ! -f "$synth/groundtruth.txt" ]; then
+  rm -rf "$synth"
+  "$build/bin/plumb" synth --out "$synth" --preset textured --seed 1 --frames "$guest_frames" >/dev/null ||
+    fail "plumb synth failed"
+fi
+echo "vm_camera: synthetic scene, $guest_frames frames ($(elapsed "$t0") s)"
+
 # --- initramfs ---------------------------------------------------------------------------------------
 t0=$(date +%s.%N)
 initrd="$work/initramfs"
@@ -118,7 +152,7 @@ mkdir -p "$initrd"/{bin,sbin,dev,proc,sys,tmp,run,etc,vmcam,lib/modules/"$kver"/
 cp /bin/busybox "$initrd/bin/busybox"
 cp "$root/scripts/vm_camera_guest.sh" "$initrd/init"
 chmod +x "$initrd/init"
-modules=(vivid v4l2loopback-deps dummy_hcd libcomposite usb_f_uvc uvcvideo usbip-vudc vhci-hcd usbip-core)
+modules=(vivid v4l2loopback-deps dummy_hcd libcomposite usb_f_uvc usb_f_ss_lb uvcvideo usbip-vudc vhci-hcd usbip-core)
 mdir="$kroot/lib/modules/$kver"
 copy_module() {  # the module and everything modules.dep says it needs
   local line
@@ -138,7 +172,7 @@ cp "$mdir"/modules.{order,builtin,builtin.modinfo} "$initrd/lib/modules/$kver/"
 depmod -b "$initrd" "$kver"
 # Programs and every shared library they load.
 guest_programs=("$build/bin/plumb" "$build/bin/plumb_vmcam_feeder" "$build/bin/plumb_vmcam_v4l2ctl"
-                "$build/bin/plumb_vmcam_uvc_gadget")
+                "$build/bin/plumb_vmcam_uvc_gadget" "$build/bin/plumb_vmcam_usbip")
 for p in "${guest_programs[@]}"; do cp "$p" "$initrd/bin/"; done
 cp "$(readlink -f "$(command -v udevadm)")" "$initrd/sbin/udevadm"
 ln -s udevadm "$initrd/sbin/systemd-udevd"
@@ -149,25 +183,19 @@ for p in "${guest_programs[@]}" "$initrd/sbin/udevadm"; do
     cp -nL "$lib" "$initrd$lib"
   done
 done
+cp -r "$synth" "$initrd/vmcam/synth"
 printf 'root:x:0:0:root:/:/bin/sh\n' >"$initrd/etc/passwd"
 printf 'root:x:0:\n' >"$initrd/etc/group"
 (cd "$initrd" && find . | cpio -o -H newc --quiet) >"$work/initramfs.cpio"
 echo "vm_camera: initramfs $(du -m "$work/initramfs.cpio" | cut -f1) MiB ($(elapsed "$t0") s)"
 
 # --- boot ------------------------------------------------------------------------------------------
-if [ "$accel" = kvm ]; then
-  accel_flags=(-enable-kvm -cpu host)
-  guest_fps=10 guest_frames=120 timeout_s="${PLUMB_VM_TIMEOUT:-480}"
-else
-  accel_flags=(-accel tcg -cpu max)
-  guest_fps=2 guest_frames=40 timeout_s="${PLUMB_VM_TIMEOUT:-1500}"
-fi
 log="$work/console.log"
 t0=$(date +%s.%N)
 set +e
 timeout "$timeout_s" qemu-system-x86_64 "${accel_flags[@]}" -m 2048 -smp 2 -nographic -no-reboot \
   -kernel "$kroot/boot/vmlinuz-$kver" -initrd "$work/initramfs.cpio" \
-  -append "console=ttyS0 quiet loglevel=4 panic=-1 vmcam.accel=$accel vmcam.fps=$guest_fps vmcam.frames=$guest_frames" \
+  -append "console=ttyS0 quiet loglevel=4 panic=-1 vmcam.accel=$accel vmcam.fps=$guest_fps vmcam.only=${PLUMB_VM_ONLY:-all}" \
   </dev/null >"$log" 2>&1
 qemu_status=$?
 set -e

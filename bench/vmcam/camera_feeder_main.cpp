@@ -3,16 +3,18 @@
 // bench (scripts/vm_camera_test.sh, docs/DRIVERS.md "The virtual-machine camera bench").
 //
 //   plumb_vmcam_feeder feed --source SPEC --colour DEV --depth DEV --out-dir DIR
-//                           [--fps F (10)] [--frames N (all)]
+//                           [--fps F (10)] [--frames N (all)] [--gt FILE (SPEC/groundtruth.txt)]
 //   plumb_vmcam_feeder match --sent DIR/sent.txt --trajectory TRAJ
 //
-// feed: frame by frame, paced at F Hz, converts colour to YUYV (BT.601 limited range) and depth to
-// millimetres, and write()s them to the loopback output nodes (v4l2loopback stamps each write with
+// feed: loads every frame first (a TUM folder, e.g. one `plumb synth` wrote, or a synth: spec) and
+// converts colour to YUYV (BT.601 limited range) and depth to millimetres; then, paced at F Hz,
+// write()s them to the loopback output nodes (v4l2loopback stamps each write with
 // CLOCK_MONOTONIC). Depth goes out as V4L2_PIX_FMT_Y16 because v4l2loopback 0.12 does not list
 // Z16; both are 16-bit little-endian, and plumb's depth node accepts either. It also writes, in DIR:
 //   replay.plumbrec  the frames exactly as plumb decodes them (YUYV -> BGR, depth in mm), stamped
 //                    with the time of their write: "a replay of the same frames";
-//   groundtruth.txt  the scene's true poses at those stamps (synthetic sources);
+//   groundtruth.txt  the true poses at those stamps (synth: specs, or a folder's groundtruth.txt
+//                    associated to the frames within 20 ms);
 //   camera.txt       the source's intrinsics with depth_factor 1000 (millimetres);
 //   sent.txt         `index t_colour t_depth` per frame written (CLOCK_MONOTONIC seconds).
 // match: which sent frame the trajectory starts at, and how many sent frames after it have no
@@ -114,91 +116,108 @@ Status writeFrame(int fd, const std::string& path, const void* data, std::size_t
 }
 
 struct FeedOptions {
-  std::string source, colour, depth, out_dir;
+  std::string source, colour, depth, out_dir, gt;
   double fps = 10;
   long frames = -1;
 };
 
-int feed(const FeedOptions& o) {
+// One frame as it goes out: YUYV colour and depth in millimetres, and its true pose if known.
+struct OutgoingFrame {
+  std::vector<uint8_t> yuyv;
+  cv::Mat depth_mm;
+  bool has_truth = false;
+  plumb::StampedPose truth;
+};
+
+// The ground-truth pose nearest in time to `t` (within 20 ms, the TUM benchmark's association).
+const plumb::StampedPose* nearestPose(const std::vector<plumb::StampedPose>& poses, double t) {
+  const plumb::StampedPose* best = nullptr;
+  for (const plumb::StampedPose& p : poses)
+    if (std::fabs(p.timestamp - t) <= 0.02 && (!best || std::fabs(p.timestamp - t) < std::fabs(best->timestamp - t)))
+      best = &p;
+  return best;
+}
+
+// Reads, converts and keeps every frame first, so decoding never disturbs the paced writes.
+Status loadFrames(const FeedOptions& o, plumb::PinholeCamera* camera, std::vector<OutgoingFrame>* frames) {
   std::unique_ptr<plumb::FrameSource> source;
-  std::unique_ptr<plumb::SyntheticSource> synth;
-  Status st;
+  std::vector<plumb::StampedPose> truth;
   if (plumb::isSynthSpec(o.source)) {
-    st = plumb::openSynthSpec(o.source, false, &synth);
+    std::unique_ptr<plumb::SyntheticSource> synth;
+    PLUMB_RETURN_IF_ERROR(plumb::openSynthSpec(o.source, false, &synth));
+    truth = plumb::syntheticGroundTruth(synth->scene(), long(synth->frameCount()));
+    source = std::move(synth);
   } else {
-    st = plumb::openFrameSource(o.source, "", &source);
+    PLUMB_RETURN_IF_ERROR(plumb::openFrameSource(o.source, "", &source));
+    const std::string gt = o.gt.empty() ? o.source + "/groundtruth.txt" : o.gt;
+    if (std::ifstream(gt).good()) PLUMB_RETURN_IF_ERROR(plumb::readTumTrajectory(gt, &truth));
   }
-  if (!st.ok()) {
-    std::fprintf(stderr, "feeder: %s\n", st.message().c_str());
-    return 1;
+  *camera = source->camera();
+  camera->depth_factor = 1000.0;
+  plumb::RgbdImage in;
+  for (long index = 0; o.frames < 0 || index < o.frames; ++index) {
+    const plumb::SourceResult r = source->next(in);
+    if (r == plumb::SourceResult::kEndOfStream) break;
+    if (r != plumb::SourceResult::kFrame) return source->lastError();
+    OutgoingFrame f;
+    bgrToYuyv(in.bgr, &f.yuyv);
+    depthToMillimetres(in.depth_raw, in.depth_factor, &f.depth_mm);
+    if (const plumb::StampedPose* pose = nearestPose(truth, in.timestamp_s)) {
+      f.has_truth = true;
+      f.truth = *pose;
+    }
+    frames->push_back(std::move(f));
   }
-  plumb::FrameSource& frames = synth ? *synth : *source;
-  plumb::PinholeCamera camera = frames.camera();
-  camera.depth_factor = 1000.0;
+  return Status::Ok();
+}
+
+Status feed(const FeedOptions& o) {
+  plumb::PinholeCamera camera;
+  std::vector<OutgoingFrame> frames;
+  const int64_t load_start = monotonicNs();
+  PLUMB_RETURN_IF_ERROR(loadFrames(o, &camera, &frames));
+  const double load_ms = (monotonicNs() - load_start) * 1e-6;
   int colour_fd = -1, depth_fd = -1;
-  st = openOutput(o.colour, V4L2_PIX_FMT_YUYV, camera.width, camera.height, 2, &colour_fd);
-  if (st.ok()) st = openOutput(o.depth, V4L2_PIX_FMT_Y16, camera.width, camera.height, 2, &depth_fd);
-  if (st.ok()) st = plumb::writeCameraFile(o.out_dir + "/camera.txt", camera);
+  PLUMB_RETURN_IF_ERROR(openOutput(o.colour, V4L2_PIX_FMT_YUYV, camera.width, camera.height, 2, &colour_fd));
+  PLUMB_RETURN_IF_ERROR(openOutput(o.depth, V4L2_PIX_FMT_Y16, camera.width, camera.height, 2, &depth_fd));
   std::unique_ptr<plumb::RecordingWriter> replay;
   plumb::RecordingWriterOptions writer_options;
   writer_options.colour_codec = writer_options.depth_codec = plumb::ImageCodec::kRaw;
   writer_options.fsync = plumb::FsyncPolicy::kNever;
-  if (st.ok()) st = plumb::RecordingWriter::open(o.out_dir + "/replay.plumbrec", camera, writer_options, &replay);
-  if (!st.ok()) {
-    std::fprintf(stderr, "feeder: %s\n", st.message().c_str());
-    return 1;
-  }
+  PLUMB_RETURN_IF_ERROR(plumb::RecordingWriter::open(o.out_dir + "/replay.plumbrec", camera, writer_options, &replay));
   std::FILE* sent = std::fopen((o.out_dir + "/sent.txt").c_str(), "w");
-  if (!sent) {
-    std::fprintf(stderr, "feeder: cannot write %s/sent.txt\n", o.out_dir.c_str());
-    return 1;
-  }
+  if (!sent) return Status::Error("cannot write " + o.out_dir + "/sent.txt");
   std::fprintf(sent, "# index t_colour t_depth (CLOCK_MONOTONIC s, middle of the write() call)\n");
+  // The camera file last: it tells the bench that the feeder is about to write the first frame.
+  PLUMB_RETURN_IF_ERROR(plumb::writeCameraFile(o.out_dir + "/camera.txt", camera));
   const int64_t period_ns = int64_t(1e9 / o.fps);
-  plumb::RgbdImage in, decoded;
-  std::vector<uint8_t> yuyv;
+  plumb::RgbdImage decoded;
   std::vector<plumb::StampedPose> truth;
-  std::vector<plumb::StampedPose> scene_truth;
-  if (synth) scene_truth = plumb::syntheticGroundTruth(synth->scene(), long(synth->frameCount()));
   int64_t due_ns = monotonicNs();
-  long index = 0;
-  double render_ms = 0;
-  for (; o.frames < 0 || index < o.frames; ++index) {
-    const int64_t render_start = monotonicNs();
-    const plumb::SourceResult r = frames.next(in);
-    if (r == plumb::SourceResult::kEndOfStream) break;
-    if (r != plumb::SourceResult::kFrame) {
-      std::fprintf(stderr, "feeder: source: %s\n", frames.lastError().message().c_str());
-      return 1;
-    }
-    bgrToYuyv(in.bgr, &yuyv);
-    plumb::yuyvToBgr(yuyv.data(), camera.width, camera.height, std::size_t(camera.width) * 2, decoded.bgr);
-    depthToMillimetres(in.depth_raw, in.depth_factor, &decoded.depth_raw);
-    render_ms += (monotonicNs() - render_start) * 1e-6;
-    // Absolute schedule: a slow frame is sent at once and the next ones catch up, no drift.
+  int64_t late_ns = 0;
+  for (std::size_t index = 0; index < frames.size(); ++index) {
+    const OutgoingFrame& f = frames[index];
+    // Absolute schedule: no drift; a late frame goes at once and is counted.
     timespec due{time_t(due_ns / 1000000000), long(due_ns % 1000000000)};
     clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &due, nullptr);
-    due_ns = std::max(due_ns + period_ns, monotonicNs());
+    late_ns = std::max(late_ns, monotonicNs() - due_ns);
+    due_ns += period_ns;
     int64_t t_colour = 0, t_depth = 0;
-    st = writeFrame(colour_fd, o.colour, yuyv.data(), yuyv.size(), &t_colour);
-    if (st.ok()) st = writeFrame(depth_fd, o.depth, decoded.depth_raw.data, decoded.depth_raw.total() * 2, &t_depth);
-    if (!st.ok()) {
-      std::fprintf(stderr, "feeder: %s\n", st.message().c_str());
-      return 1;
-    }
-    std::fprintf(sent, "%ld %.6f %.6f\n", index, t_colour * 1e-9, t_depth * 1e-9);
+    PLUMB_RETURN_IF_ERROR(writeFrame(colour_fd, o.colour, f.yuyv.data(), f.yuyv.size(), &t_colour));
+    PLUMB_RETURN_IF_ERROR(writeFrame(depth_fd, o.depth, f.depth_mm.data, f.depth_mm.total() * 2, &t_depth));
+    std::fprintf(sent, "%zu %.6f %.6f\n", index, t_colour * 1e-9, t_depth * 1e-9);
+    std::fflush(sent);
+    // The replay gets exactly what plumb decodes, stamped like the live frames.
+    plumb::yuyvToBgr(f.yuyv.data(), camera.width, camera.height, std::size_t(camera.width) * 2, decoded.bgr);
+    f.depth_mm.copyTo(decoded.depth_raw);
     decoded.sequence = uint64_t(index);
     decoded.timestamp_s = t_colour * 1e-9;
     decoded.depth_timestamp_s = t_depth * 1e-9;
     decoded.t_sensor_ns = t_colour;
     decoded.depth_factor = 1000.0;
-    st = replay->append(decoded);
-    if (!st.ok()) {
-      std::fprintf(stderr, "feeder: %s\n", st.message().c_str());
-      return 1;
-    }
-    if (std::size_t(index) < scene_truth.size()) {
-      plumb::StampedPose pose = scene_truth[std::size_t(index)];
+    PLUMB_RETURN_IF_ERROR(replay->append(decoded));
+    if (f.has_truth) {
+      plumb::StampedPose pose = f.truth;
       pose.timestamp = t_colour * 1e-9;
       truth.push_back(pose);
     }
@@ -206,15 +225,11 @@ int feed(const FeedOptions& o) {
   std::fclose(sent);
   close(colour_fd);
   close(depth_fd);
-  st = replay->close();
-  if (st.ok() && !truth.empty()) st = plumb::writeTumTrajectory(o.out_dir + "/groundtruth.txt", truth);
-  if (!st.ok()) {
-    std::fprintf(stderr, "feeder: %s\n", st.message().c_str());
-    return 1;
-  }
-  std::printf("feeder: wrote %ld frames at %.1f Hz (render + convert %.1f ms/frame)\n", index, o.fps,
-              index ? render_ms / double(index) : 0.0);
-  return 0;
+  PLUMB_RETURN_IF_ERROR(replay->close());
+  if (!truth.empty()) PLUMB_RETURN_IF_ERROR(plumb::writeTumTrajectory(o.out_dir + "/groundtruth.txt", truth));
+  std::printf("feeder: wrote %zu frames at %.1f Hz (loading %.0f ms/frame, at most %.1f ms late)\n", frames.size(),
+              o.fps, frames.empty() ? 0.0 : load_ms / double(frames.size()), late_ns * 1e-6);
+  return Status::Ok();
 }
 
 // Timestamps of a trajectory file, one per input frame: pose lines and `# <t> lost|dropped` markers.
@@ -286,6 +301,7 @@ int main(int argc, char** argv) {
     else if (key == "--out-dir") feed_options.out_dir = value;
     else if (key == "--fps") feed_options.fps = std::atof(value.c_str());
     else if (key == "--frames") feed_options.frames = std::atol(value.c_str());
+    else if (key == "--gt") feed_options.gt = value;
     else if (key == "--sent") sent = value;
     else if (key == "--trajectory") trajectory = value;
     else {
@@ -294,8 +310,11 @@ int main(int argc, char** argv) {
     }
   }
   if (command == "feed" && !feed_options.source.empty() && !feed_options.colour.empty() &&
-      !feed_options.depth.empty() && !feed_options.out_dir.empty() && feed_options.fps > 0)
-    return feed(feed_options);
+      !feed_options.depth.empty() && !feed_options.out_dir.empty() && feed_options.fps > 0) {
+    const Status st = feed(feed_options);
+    if (!st.ok()) std::fprintf(stderr, "feeder: %s\n", st.message().c_str());
+    return st.ok() ? 0 : 1;
+  }
   if (command == "match" && !sent.empty() && !trajectory.empty()) return match(sent, trajectory);
   std::fprintf(stderr,
                "usage: %s feed --source SPEC --colour DEV --depth DEV --out-dir DIR [--fps F] [--frames N]\n"

@@ -1,7 +1,7 @@
 // plumb_vmcam_uvc_gadget: the userspace half of a UVC camera gadget (usb_f_uvc configured through
 // configfs by scripts/vm_camera_guest.sh), for the virtual-machine camera bench. The kernel function
 // forwards the host's UVC class requests and stream starts as V4L2 events on its video output
-// node; this program answers them (one YUYV 640x480 format at 30 Hz: probe/commit) and, while the
+// node; this program answers them (one YUYV 320x240 format at 15 Hz: probe/commit) and, while the
 // host streams, fills the node's buffers with a moving test pattern. Stops after --seconds S.
 //   plumb_vmcam_uvc_gadget --device /dev/videoN [--seconds S (30)]
 // Prints what it saw: requests answered, stream on/off, frames queued. Exit 1 on a node error.
@@ -25,11 +25,14 @@
 
 namespace {
 
-constexpr int kWidth = 640, kHeight = 480;
+// What the configfs function announces (scripts/vm_camera_guest.sh make_gadget): YUYV 320x240 at
+// 15 Hz, small enough for USB/IP under an emulated CPU.
+constexpr int kWidth = 320, kHeight = 240;
 constexpr uint32_t kFrameBytes = kWidth * kHeight * 2;
-constexpr uint32_t kInterval100ns = 333333;  // 30 Hz
+constexpr uint32_t kInterval100ns = 666666;  // 15 Hz
 constexpr int kBuffers = 4;
 
+// Failure is a negative result: usb_f_uvc's VIDIOC_REQBUFS returns the buffer count (6.1).
 int xioctl(int fd, unsigned long request, void* arg) {
   int r;
   do {
@@ -52,7 +55,7 @@ struct Gadget {
     c->bFrameIndex = 1;
     c->dwFrameInterval = kInterval100ns;
     c->dwMaxVideoFrameSize = kFrameBytes;
-    c->dwMaxPayloadTransferSize = 1024;
+    c->dwMaxPayloadTransferSize = 3072;  // streaming_maxpacket (configfs)
     c->bmFramingInfo = 3;
     c->bPreferedVersion = c->bMinVersion = c->bMaxVersion = 1;
   }
@@ -73,7 +76,7 @@ struct Gadget {
     b.index = index;
     fill(buffers[index].first);
     b.bytesused = kFrameBytes;
-    if (xioctl(fd, VIDIOC_QBUF, &b) != 0) {
+    if (xioctl(fd, VIDIOC_QBUF, &b) < 0) {
       std::fprintf(stderr, "uvc gadget: VIDIOC_QBUF: %s\n", std::strerror(errno));
       return false;
     }
@@ -90,18 +93,18 @@ struct Gadget {
     fmt.fmt.pix.pixelformat = V4L2_PIX_FMT_YUYV;
     fmt.fmt.pix.field = V4L2_FIELD_NONE;
     fmt.fmt.pix.sizeimage = kFrameBytes;
-    if (xioctl(fd, VIDIOC_S_FMT, &fmt) != 0) return report("VIDIOC_S_FMT");
+    if (xioctl(fd, VIDIOC_S_FMT, &fmt) < 0) return report("VIDIOC_S_FMT");
     v4l2_requestbuffers req{};
     req.count = kBuffers;
     req.type = V4L2_BUF_TYPE_VIDEO_OUTPUT;
     req.memory = V4L2_MEMORY_MMAP;
-    if (xioctl(fd, VIDIOC_REQBUFS, &req) != 0) return report("VIDIOC_REQBUFS");
+    if (xioctl(fd, VIDIOC_REQBUFS, &req) < 0) return report("VIDIOC_REQBUFS");
     for (uint32_t i = 0; i < req.count; ++i) {
       v4l2_buffer b{};
       b.type = V4L2_BUF_TYPE_VIDEO_OUTPUT;
       b.memory = V4L2_MEMORY_MMAP;
       b.index = i;
-      if (xioctl(fd, VIDIOC_QUERYBUF, &b) != 0) return report("VIDIOC_QUERYBUF");
+      if (xioctl(fd, VIDIOC_QUERYBUF, &b) < 0) return report("VIDIOC_QUERYBUF");
       void* p = mmap(nullptr, b.length, PROT_READ | PROT_WRITE, MAP_SHARED, fd, b.m.offset);
       if (p == MAP_FAILED) return report("mmap");
       buffers.emplace_back(p, b.length);
@@ -109,7 +112,7 @@ struct Gadget {
     for (uint32_t i = 0; i < buffers.size(); ++i)
       if (!queue(i)) return false;
     int type = V4L2_BUF_TYPE_VIDEO_OUTPUT;
-    if (xioctl(fd, VIDIOC_STREAMON, &type) != 0) return report("VIDIOC_STREAMON");
+    if (xioctl(fd, VIDIOC_STREAMON, &type) < 0) return report("VIDIOC_STREAMON");
     streaming = true;
     std::printf("uvc gadget: host started streaming\n");
     return true;
@@ -160,7 +163,7 @@ struct Gadget {
       resp.length = std::min<int>(req.wLength, sizeof c);
       std::memcpy(resp.data, &c, size_t(resp.length));
     }
-    if (xioctl(fd, UVCIOC_SEND_RESPONSE, &resp) != 0) report("UVCIOC_SEND_RESPONSE");
+    if (xioctl(fd, UVCIOC_SEND_RESPONSE, &resp) < 0) report("UVCIOC_SEND_RESPONSE");
   }
 };
 
@@ -187,7 +190,7 @@ int main(int argc, char** argv) {
                         UVC_EVENT_STREAMON, UVC_EVENT_STREAMOFF}) {
     v4l2_event_subscription sub{};
     sub.type = type;
-    if (xioctl(g.fd, VIDIOC_SUBSCRIBE_EVENT, &sub) != 0) return g.report("VIDIOC_SUBSCRIBE_EVENT") ? 0 : 1;
+    if (xioctl(g.fd, VIDIOC_SUBSCRIBE_EVENT, &sub) < 0) return g.report("VIDIOC_SUBSCRIBE_EVENT") ? 0 : 1;
   }
   std::printf("uvc gadget: serving %s\n", device.c_str());
   std::fflush(stdout);
