@@ -188,7 +188,7 @@ Status runToOutputs(FrameSource& source, const SystemOptions& system_options, co
   PLUMB_RETURN_IF_ERROR(OdometrySystem::create(source.camera(), system_options, &system));
   PLUMB_RETURN_IF_ERROR(validate(run_options));
   PLUMB_RETURN_IF_ERROR(outputs.open());
-  SourceCapture capture(source);
+  SourceCapture capture(source, run_options.stop);
   Status status = runOdometry(capture, *system, outputs, run_options, &record->run);
   const Status closed = outputs.close();
   if (status.ok()) status = closed;

@@ -4,7 +4,9 @@
 //
 //   plumb_vmcam_feeder feed --source SPEC --colour DEV --depth DEV --out-dir DIR
 //                           [--fps F (10)] [--frames N (all)] [--gt FILE (SPEC/groundtruth.txt)]
-//   plumb_vmcam_feeder match --sent DIR/sent.txt --trajectory TRAJ
+//                           [--linger S (2.5)]
+//   plumb_vmcam_feeder match --sent DIR/sent.txt --trajectory TRAJ [--received-out FILE]
+//   plumb_vmcam_feeder select --recording REC --indices FILE --out OUT
 //
 // feed: loads every frame first (a TUM folder, e.g. one `plumb synth` wrote, or a synth: spec) and
 // converts colour to YUYV (BT.601 limited range) and depth to millimetres; then, paced at F Hz,
@@ -16,9 +18,16 @@
 //   groundtruth.txt  the true poses at those stamps (synth: specs, or a folder's groundtruth.txt
 //                    associated to the frames within 20 ms);
 //   camera.txt       the source's intrinsics with depth_factor 1000 (millimetres);
-//   sent.txt         `index t_colour t_depth` per frame written (CLOCK_MONOTONIC seconds).
+//   sent.txt         `index t_colour t_depth t_colour_start` per frame (CLOCK_MONOTONIC seconds: when
+//                    each write() returned, and when the colour write() started).
+// The stamps of the replay and of groundtruth.txt are when the colour write() returned, within a
+// write's duration of the driver's own stamp. The outputs stay open --linger S (2.5) seconds after
+// the last frame.
 // match: which sent frame the trajectory starts at, and how many sent frames after it have no
-// trajectory line (lost on the way). Prints `first_frame K live_frames M sent_from_first S lost L`.
+// trajectory line (lost on the way). Prints `first_frame K live_frames M sent_from_first S lost L`;
+// --received-out lists the indices of the frames the trajectory has.
+// select: the frames of REC whose sequence numbers FILE lists, as recording OUT (the replay of
+// exactly the frames a live run received).
 #include <fcntl.h>
 #include <linux/videodev2.h>
 #include <sys/ioctl.h>
@@ -38,6 +47,7 @@
 
 #include "drivers/dataset/camera_file.h"
 #include "drivers/open/open_source.h"
+#include "drivers/recording/recording_source.h"
 #include "drivers/recording/recording_writer.h"
 #include "drivers/synth/synth_spec.h"
 #include "drivers/trajectory/trajectory_io.h"
@@ -102,16 +112,16 @@ Status openOutput(const std::string& path, uint32_t fourcc, int width, int heigh
   return Status::Ok();
 }
 
-// One write() of a whole frame; returns the middle of the call on CLOCK_MONOTONIC (the driver
-// stamps the buffer inside it).
-Status writeFrame(int fd, const std::string& path, const void* data, std::size_t size, int64_t* stamp_ns) {
-  const int64_t before = monotonicNs();
+// One write() of a whole frame. The driver stamps the buffer on CLOCK_MONOTONIC inside the call,
+// after copying it: between *before_ns and *after_ns, close to the latter.
+Status writeFrame(int fd, const std::string& path, const void* data, std::size_t size, int64_t* before_ns,
+                  int64_t* after_ns) {
+  *before_ns = monotonicNs();
   const ssize_t n = write(fd, data, size);
-  const int64_t after = monotonicNs();
+  *after_ns = monotonicNs();
   if (n != ssize_t(size))
     return Status::Error(path + ": write of " + std::to_string(size) + " bytes returned " + std::to_string(n) +
                          (n < 0 ? std::string(": ") + std::strerror(errno) : std::string()));
-  *stamp_ns = before + (after - before) / 2;
   return Status::Ok();
 }
 
@@ -119,6 +129,9 @@ struct FeedOptions {
   std::string source, colour, depth, out_dir, gt;
   double fps = 10;
   long frames = -1;
+  // Seconds the outputs stay open after the last frame: v4l2loopback (exclusive_caps) stops being
+  // a capture device when its writer closes, so the reader gets this long to take what is queued.
+  double linger_s = 2.5;
 };
 
 // One frame as it goes out: YUYV colour and depth in millimetres, and its true pose if known.
@@ -187,7 +200,7 @@ Status feed(const FeedOptions& o) {
   PLUMB_RETURN_IF_ERROR(plumb::RecordingWriter::open(o.out_dir + "/replay.plumbrec", camera, writer_options, &replay));
   std::FILE* sent = std::fopen((o.out_dir + "/sent.txt").c_str(), "w");
   if (!sent) return Status::Error("cannot write " + o.out_dir + "/sent.txt");
-  std::fprintf(sent, "# index t_colour t_depth (CLOCK_MONOTONIC s, middle of the write() call)\n");
+  std::fprintf(sent, "# index t_colour t_depth t_colour_start (CLOCK_MONOTONIC s; write() returned, started)\n");
   // The camera file last: it tells the bench that the feeder is about to write the first frame.
   PLUMB_RETURN_IF_ERROR(plumb::writeCameraFile(o.out_dir + "/camera.txt", camera));
   const int64_t period_ns = int64_t(1e9 / o.fps);
@@ -202,10 +215,11 @@ Status feed(const FeedOptions& o) {
     clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &due, nullptr);
     late_ns = std::max(late_ns, monotonicNs() - due_ns);
     due_ns += period_ns;
-    int64_t t_colour = 0, t_depth = 0;
-    PLUMB_RETURN_IF_ERROR(writeFrame(colour_fd, o.colour, f.yuyv.data(), f.yuyv.size(), &t_colour));
-    PLUMB_RETURN_IF_ERROR(writeFrame(depth_fd, o.depth, f.depth_mm.data, f.depth_mm.total() * 2, &t_depth));
-    std::fprintf(sent, "%zu %.6f %.6f\n", index, t_colour * 1e-9, t_depth * 1e-9);
+    int64_t t_colour_start = 0, t_colour = 0, t_depth_start = 0, t_depth = 0;
+    PLUMB_RETURN_IF_ERROR(writeFrame(colour_fd, o.colour, f.yuyv.data(), f.yuyv.size(), &t_colour_start, &t_colour));
+    PLUMB_RETURN_IF_ERROR(
+        writeFrame(depth_fd, o.depth, f.depth_mm.data, f.depth_mm.total() * 2, &t_depth_start, &t_depth));
+    std::fprintf(sent, "%zu %.6f %.6f %.6f\n", index, t_colour * 1e-9, t_depth * 1e-9, t_colour_start * 1e-9);
     std::fflush(sent);
     // The replay gets exactly what plumb decodes, stamped like the live frames.
     plumb::yuyvToBgr(f.yuyv.data(), camera.width, camera.height, std::size_t(camera.width) * 2, decoded.bgr);
@@ -223,6 +237,8 @@ Status feed(const FeedOptions& o) {
     }
   }
   std::fclose(sent);
+  timespec linger{time_t(o.linger_s), long((o.linger_s - double(time_t(o.linger_s))) * 1e9)};
+  nanosleep(&linger, nullptr);
   close(colour_fd);
   close(depth_fd);
   PLUMB_RETURN_IF_ERROR(replay->close());
@@ -253,15 +269,19 @@ std::vector<double> trajectoryStamps(const std::string& path) {
   return stamps;
 }
 
-int match(const std::string& sent_path, const std::string& trajectory_path) {
-  std::vector<double> sent;
+int match(const std::string& sent_path, const std::string& trajectory_path, const std::string& received_out) {
+  struct Sent {
+    double start, end;  // the colour write() call
+  };
+  std::vector<Sent> sent;
   std::ifstream in(sent_path);
   std::string line;
   while (std::getline(in, line)) {
     if (line.empty() || line[0] == '#') continue;
     long index = 0;
-    double t_colour = 0, t_depth = 0;
-    if (std::sscanf(line.c_str(), "%ld %lf %lf", &index, &t_colour, &t_depth) == 3) sent.push_back(t_colour);
+    double t_colour = 0, t_depth = 0, t_start = 0;
+    if (std::sscanf(line.c_str(), "%ld %lf %lf %lf", &index, &t_colour, &t_depth, &t_start) == 4)
+      sent.push_back({t_start, t_colour});
   }
   const std::vector<double> live = trajectoryStamps(trajectory_path);
   if (sent.empty() || live.empty()) {
@@ -269,22 +289,61 @@ int match(const std::string& sent_path, const std::string& trajectory_path) {
                  trajectory_path.c_str(), live.size());
     return 1;
   }
-  // Every live stamp must be one sent frame's (the driver stamps inside the write: < 5 ms apart).
+  // A live stamp is a sent frame's when the driver took it during that frame's write() (1 ms of
+  // slack for the trajectory's microsecond rounding).
   std::size_t first = sent.size(), matched = 0, unmatched = 0;
+  std::FILE* received = received_out.empty() ? nullptr : std::fopen(received_out.c_str(), "w");
   for (double t : live) {
-    const auto it = std::min_element(sent.begin(), sent.end(),
-                                     [t](double a, double b) { return std::fabs(a - t) < std::fabs(b - t); });
-    if (std::fabs(*it - t) > 0.005) {
-      ++unmatched;
+    std::size_t k = 0;
+    while (k < sent.size() && !(t >= sent[k].start - 1e-3 && t <= sent[k].end + 1e-3)) ++k;
+    if (k == sent.size()) {
+      if (unmatched++ < 3) std::fprintf(stderr, "match: live stamp %.6f was not taken during a write\n", t);
       continue;
     }
     ++matched;
-    first = std::min(first, std::size_t(it - sent.begin()));
+    first = std::min(first, k);
+    if (received) std::fprintf(received, "%zu\n", k);
   }
+  if (received) std::fclose(received);
   const std::size_t sent_from_first = first < sent.size() ? sent.size() - first : 0;
   std::printf("first_frame %zu live_frames %zu matched %zu unmatched %zu sent_from_first %zu lost %ld\n", first,
               live.size(), matched, unmatched, sent_from_first, long(sent_from_first) - long(matched));
   return unmatched == 0 ? 0 : 1;
+}
+
+// The frames of a recording whose sequence numbers are listed (one per line), in a new recording:
+// the replay of exactly the frames a live run received.
+int select(const std::string& recording, const std::string& indices_path, const std::string& out_path) {
+  std::vector<uint64_t> wanted;
+  std::ifstream indices(indices_path);
+  for (uint64_t k; indices >> k;) wanted.push_back(k);
+  std::unique_ptr<plumb::RecordingSource> source;
+  Status st = plumb::RecordingSource::open(recording, &source);
+  std::unique_ptr<plumb::RecordingWriter> writer;
+  plumb::RecordingWriterOptions options;
+  options.colour_codec = options.depth_codec = plumb::ImageCodec::kRaw;
+  options.fsync = plumb::FsyncPolicy::kNever;
+  if (st.ok()) st = plumb::RecordingWriter::open(out_path, source->camera(), options, &writer);
+  plumb::RgbdImage frame;
+  std::size_t kept = 0;
+  while (st.ok()) {
+    const plumb::SourceResult r = source->next(frame);
+    if (r == plumb::SourceResult::kEndOfStream) break;
+    if (r != plumb::SourceResult::kFrame) {
+      st = source->lastError();
+      break;
+    }
+    if (std::find(wanted.begin(), wanted.end(), frame.sequence) == wanted.end()) continue;
+    st = writer->append(frame);
+    ++kept;
+  }
+  if (st.ok()) st = writer->close();
+  if (!st.ok()) {
+    std::fprintf(stderr, "select: %s\n", st.message().c_str());
+    return 1;
+  }
+  std::printf("select: %zu of the listed %zu frames written to %s\n", kept, wanted.size(), out_path.c_str());
+  return kept == wanted.size() ? 0 : 1;
 }
 
 }  // namespace
@@ -292,7 +351,7 @@ int match(const std::string& sent_path, const std::string& trajectory_path) {
 int main(int argc, char** argv) {
   const std::string command = argc > 1 ? argv[1] : "";
   FeedOptions feed_options;
-  std::string sent, trajectory;
+  std::string sent, trajectory, received_out, recording, indices, out;
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string key = argv[i], value = argv[i + 1];
     if (key == "--source") feed_options.source = value;
@@ -302,8 +361,13 @@ int main(int argc, char** argv) {
     else if (key == "--fps") feed_options.fps = std::atof(value.c_str());
     else if (key == "--frames") feed_options.frames = std::atol(value.c_str());
     else if (key == "--gt") feed_options.gt = value;
+    else if (key == "--linger") feed_options.linger_s = std::atof(value.c_str());
     else if (key == "--sent") sent = value;
     else if (key == "--trajectory") trajectory = value;
+    else if (key == "--received-out") received_out = value;
+    else if (key == "--recording") recording = value;
+    else if (key == "--indices") indices = value;
+    else if (key == "--out") out = value;
     else {
       std::fprintf(stderr, "feeder: unknown option %s\n", key.c_str());
       return 2;
@@ -315,10 +379,13 @@ int main(int argc, char** argv) {
     if (!st.ok()) std::fprintf(stderr, "feeder: %s\n", st.message().c_str());
     return st.ok() ? 0 : 1;
   }
-  if (command == "match" && !sent.empty() && !trajectory.empty()) return match(sent, trajectory);
+  if (command == "match" && !sent.empty() && !trajectory.empty()) return match(sent, trajectory, received_out);
+  if (command == "select" && !recording.empty() && !indices.empty() && !out.empty())
+    return select(recording, indices, out);
   std::fprintf(stderr,
                "usage: %s feed --source SPEC --colour DEV --depth DEV --out-dir DIR [--fps F] [--frames N]\n"
-               "       %s match --sent FILE --trajectory FILE\n",
-               argv[0], argv[0]);
+               "       %s match --sent FILE --trajectory FILE [--received-out FILE]\n"
+               "       %s select --recording FILE --indices FILE --out FILE\n",
+               argv[0], argv[0], argv[0]);
   return 2;
 }

@@ -1,6 +1,7 @@
 #pragma once
 // FrameSource: the one interface every producer of RGB-D frames implements — dataset replay,
 // synthetic scenes, our recordings, OpenNI2, V4L2. The pipeline's capture stage only sees this.
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -50,6 +51,9 @@ class FrameSource {
   // frames missing, unpaired colour/depth, driver-flagged buffers), for run reports: a summary
   // line, then one line per recorded event. Empty when there is nothing to report (replays).
   virtual std::string healthReport() const { return ""; }
+  // A flag the caller sets to end the run (SIGINT): a live source that blocks (reconnecting with
+  // backoff) checks it and returns kNoFrame soon after. nullptr = none. Wrappers forward it.
+  virtual void setStopFlag(const std::atomic<bool>* stop) { (void)stop; }
 };
 
 }  // namespace plumb

@@ -35,6 +35,7 @@ class SkipFramesSource : public FrameSource {
   }
   SourceDamage damage() const override { return inner_->damage(); }
   std::string healthReport() const override { return inner_->healthReport(); }
+  void setStopFlag(const std::atomic<bool>* stop) override { inner_->setStopFlag(stop); }
 
  private:
   std::unique_ptr<FrameSource> inner_;

@@ -59,13 +59,14 @@ SourceResult ResilientSource::next(RgbdImage& out) {
       stats_.last_error = inner_->describe() + ": no frame for " +
                           std::to_string((clock_.nowNs() - last_frame_ns_) / 1000000) + " ms";
       record(SourceEventKind::kStallTimeout);
-      if (!recover()) return SourceResult::kError;
+      if (!recover()) return stopRequested() ? SourceResult::kNoFrame : SourceResult::kError;
       continue;
     }
     ++stats_.errors;
     stats_.last_error = inner_->lastError().message();
     record(SourceEventKind::kError);
     if (!inner_->isLive() || !recover()) {
+      if (inner_->isLive() && stopRequested()) return SourceResult::kNoFrame;
       error_ = inner_->isLive() ? error_ : inner_->lastError();
       return SourceResult::kError;
     }
@@ -79,6 +80,10 @@ bool ResilientSource::recover() {
   int64_t backoff_ns = options_.initial_backoff_ns;
   for (int attempt = 1; options_.max_reopen_attempts == 0 || attempt <= options_.max_reopen_attempts;
        ++attempt) {
+    if (stopRequested()) {  // the run is ending: stop waiting for the camera
+      stats_.time_disconnected_ns += clock_.nowNs() - failed_at_ns;
+      return false;
+    }
     ++stats_.reopen_attempts;
     const Status st = inner_->reopen();
     if (st.ok()) {

@@ -100,27 +100,10 @@ Status V4l2Capture::open(const V4l2CaptureOptions& options) {
   }
 
   v4l2_format fmt{};
-  fmt.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-  fmt.fmt.pix.width = static_cast<uint32_t>(options.width);
-  fmt.fmt.pix.height = static_cast<uint32_t>(options.height);
-  fmt.fmt.pix.pixelformat = fourcc(options.format);
-  fmt.fmt.pix.field = V4L2_FIELD_NONE;
-  if (device_.ioctl(fd_, VIDIOC_S_FMT, &fmt) < 0) {
-    const Status st = fail("VIDIOC_S_FMT", errno);
+  const Status format_status = negotiateFormat(&fmt);
+  if (!format_status.ok()) {
     close();
-    return st;
-  }
-  // Drivers adjust what they cannot do instead of failing: check what we actually got.
-  if (!acceptedSubstitute(options.format, fmt.fmt.pix.pixelformat, &format_) ||
-      fmt.fmt.pix.width != static_cast<uint32_t>(options.width) ||
-      fmt.fmt.pix.height != static_cast<uint32_t>(options.height)) {
-    const std::string got = fourccText(fmt.fmt.pix.pixelformat) + " " +
-                            std::to_string(fmt.fmt.pix.width) + "x" +
-                            std::to_string(fmt.fmt.pix.height);
-    close();
-    return Status::Error(options.device_path + ": VIDIOC_S_FMT: asked for " +
-                         pixelFormatName(options.format) + " " + std::to_string(options.width) +
-                         "x" + std::to_string(options.height) + ", driver offers " + got);
+    return format_status;
   }
   const std::size_t bytes_per_pixel =
       format_ == V4l2PixelFormat::kGrey ? 1 : (format_ == V4l2PixelFormat::kMjpeg ? 0 : 2);
@@ -180,6 +163,39 @@ Status V4l2Capture::open(const V4l2CaptureOptions& options) {
   }
   streaming_ = true;
   return Status::Ok();
+}
+
+Status V4l2Capture::negotiateFormat(v4l2_format* fmt) {
+  // Depth: Z16 first, then Y16 (same layout). A driver that cannot do a format either substitutes
+  // another one (most) or refuses it with EINVAL (v4l2loopback, whose format its writer sets).
+  const V4l2PixelFormat asked = options_.format;
+  V4l2PixelFormat candidates[2] = {asked, asked};
+  int count = 1;
+  if (asked == V4l2PixelFormat::kZ16) candidates[count++] = V4l2PixelFormat::kY16;
+  Status first_problem;
+  for (int i = 0; i < count; ++i) {
+    *fmt = v4l2_format{};
+    fmt->type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+    fmt->fmt.pix.width = static_cast<uint32_t>(options_.width);
+    fmt->fmt.pix.height = static_cast<uint32_t>(options_.height);
+    fmt->fmt.pix.pixelformat = fourcc(candidates[i]);
+    fmt->fmt.pix.field = V4L2_FIELD_NONE;
+    Status problem;
+    if (device_.ioctl(fd_, VIDIOC_S_FMT, fmt) < 0) {
+      problem = fail("VIDIOC_S_FMT", errno);
+    } else if (acceptedSubstitute(asked, fmt->fmt.pix.pixelformat, &format_) &&
+               fmt->fmt.pix.width == static_cast<uint32_t>(options_.width) &&
+               fmt->fmt.pix.height == static_cast<uint32_t>(options_.height)) {
+      return Status::Ok();
+    } else {  // drivers adjust what they cannot do instead of failing: say what we got
+      problem = Status::Error(options_.device_path + ": VIDIOC_S_FMT: asked for " + pixelFormatName(asked) + " " +
+                              std::to_string(options_.width) + "x" + std::to_string(options_.height) +
+                              ", driver offers " + fourccText(fmt->fmt.pix.pixelformat) + " " +
+                              std::to_string(fmt->fmt.pix.width) + "x" + std::to_string(fmt->fmt.pix.height));
+    }
+    if (i == 0) first_problem = problem;
+  }
+  return first_problem;
 }
 
 Status V4l2Capture::queueBuffer(uint32_t index) {

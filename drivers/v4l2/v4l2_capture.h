@@ -6,6 +6,8 @@
 //   close: VIDIOC_STREAMOFF -> munmap -> close.
 // Every failure names the device and the ioctl, e.g. "/dev/video2: VIDIOC_DQBUF failed: No such
 // device (device disconnected)".
+#include <linux/videodev2.h>
+
 #include <cstdint>
 #include <string>
 
@@ -85,6 +87,8 @@ class V4l2Capture {
     std::size_t length = 0;
   };
   Status fail(const char* what, int error_number) const;
+  // VIDIOC_S_FMT with options_.format (for Z16 also Y16); sets format_ and fills *fmt.
+  Status negotiateFormat(v4l2_format* fmt);
   Status queueBuffer(uint32_t index);
 
   V4l2Device& device_;

@@ -25,6 +25,7 @@ struct FakeV4l2Node {
   uint32_t width = 4, height = 2;
   uint32_t bytes_per_line = 8;
   uint32_t offered_width = 0;  // non-zero: S_FMT answers with this width instead (driver adjusts)
+  bool refuses_other_formats = false;  // S_FMT of another fourcc fails with EINVAL (v4l2loopback)
   int64_t first_timestamp_ns = 1'000'000'000;
   int64_t period_ns = 33'333'333;
   // Fills frame number k (k counts every frame the "sensor" produced, including unplugged time).
@@ -115,6 +116,7 @@ class FakeV4l2Device : public V4l2Device {
       }
       case VIDIOC_S_FMT: {
         auto* fmt = static_cast<v4l2_format*>(arg);
+        if (n->refuses_other_formats && fmt->fmt.pix.pixelformat != n->fourcc) return fail(EINVAL);
         fmt->fmt.pix.pixelformat = n->fourcc;
         fmt->fmt.pix.width = n->offered_width ? n->offered_width : n->width;
         fmt->fmt.pix.height = n->height;

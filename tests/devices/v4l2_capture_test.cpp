@@ -275,6 +275,14 @@ TEST(V4l2DriverFaults, DepthMayComeAsY16) {
   EXPECT_EQ(out.depth_raw.at<uint16_t>(0, 0), 1000);
   EXPECT_NE(source->healthReport().find("depth format y16"), std::string::npos) << source->healthReport();
 
+  fake.nodes["/dev/video1"].refuses_other_formats = true;  // v4l2loopback: EINVAL for Z16
+  source.reset();
+  fake.log.clear();
+  ASSERT_TRUE(V4l2Source::open(options, camera4x2(), fake, &source).ok());
+  ASSERT_EQ(source->next(out), SourceResult::kFrame);
+  EXPECT_EQ(fake.count("VIDIOC_S_FMT"), 3) << "colour; depth: Z16 refused, then Y16";
+
+  fake.nodes["/dev/video1"].refuses_other_formats = false;
   fake.nodes["/dev/video1"].fourcc = V4L2_PIX_FMT_GREY;  // 8-bit: never depth
   EXPECT_NE(V4l2Source::open(options, camera4x2(), fake, &source).message().find("asked for z16"),
             std::string::npos);
