@@ -11,6 +11,13 @@ PACKAGES=(
   python3-dev python3-pybind11 pybind11-dev python3-numpy python3-pytest
   valgrind
   clang libclang-rt-14-dev  # fuzz targets (scripts/fuzz.sh): libFuzzer is in libclang-rt-14-dev
+  # test/bench: the virtual-machine camera bench (scripts/vm_camera_test.sh, ctest vm_camera).
+  # The guest kernel (linux-image-amd64's linux-image-6.1.*), its linux-headers and the
+  # v4l2loopback-dkms source are fetched by that script with `apt-get download` and unpacked into
+  # the build folder, never installed: they always match each other, and installing the dkms
+  # package would build a module for the host's kernels. gcc-12 and make (build-essential) build
+  # v4l2loopback; udev provides the udevd that carries hot-plug events to libusb in the guest.
+  qemu-system-x86 busybox-static kmod cpio udev
 )
 # libjpeg62-turbo-dev: MJPEG cameras and JPEG images in TUM folders (optional at build time).
 # valgrind: ctest instruction_budget (bench/instructions/; skipped without it).

@@ -24,10 +24,12 @@
 // write's duration of the driver's own stamp. The outputs stay open --linger S (2.5) seconds after
 // the last frame.
 // match: which sent frame the trajectory starts at, and how many sent frames after it have no
-// trajectory line (lost on the way). Prints `first_frame K live_frames M sent_from_first S lost L`;
-// --received-out lists the indices of the frames the trajectory has.
-// select: the frames of REC whose sequence numbers FILE lists, as recording OUT (the replay of
-// exactly the frames a live run received).
+// trajectory line (lost on the way). Prints `first_frame K live_frames M matched M unmatched U
+// restamped R sent_from_first S lost L` (R: see the v4l2loopback REQBUFS quirk in match());
+// --received-out lists `index live_stamp` for the frames the trajectory has.
+// select: the frames of REC whose sequence numbers FILE lists (`index live_stamp` lines, as match
+// writes them), stamped with the live stamps, as recording OUT: the replay of exactly the frames
+// a live run received, at the times it received them.
 #include <fcntl.h>
 #include <linux/videodev2.h>
 #include <sys/ioctl.h>
@@ -291,32 +293,46 @@ int match(const std::string& sent_path, const std::string& trajectory_path, cons
   }
   // A live stamp is a sent frame's when the driver took it during that frame's write() (1 ms of
   // slack for the trajectory's microsecond rounding).
-  std::size_t first = sent.size(), matched = 0, unmatched = 0;
+  // One exception, a v4l2loopback 0.12 quirk: VIDIOC_REQBUFS re-stamps every buffer with the
+  // current time (init_buffers), so the first frame a new reader takes, written before it asked for
+  // buffers, carries the time of that request. Such a first stamp, after write k and before write
+  // k+1, is frame k, counted apart as "restamped".
+  std::size_t first = sent.size(), matched = 0, unmatched = 0, restamped = 0;
   std::FILE* received = received_out.empty() ? nullptr : std::fopen(received_out.c_str(), "w");
-  for (double t : live) {
+  for (std::size_t i = 0; i < live.size(); ++i) {
+    const double t = live[i];
     std::size_t k = 0;
     while (k < sent.size() && !(t >= sent[k].start - 1e-3 && t <= sent[k].end + 1e-3)) ++k;
+    if (k == sent.size() && i == 0) {
+      std::size_t before = 0;
+      while (before + 1 < sent.size() && sent[before + 1].start <= t) ++before;
+      if (t > sent[before].end && (before + 1 == sent.size() || t < sent[before + 1].start)) {
+        k = before;
+        ++restamped;
+      }
+    }
     if (k == sent.size()) {
       if (unmatched++ < 3) std::fprintf(stderr, "match: live stamp %.6f was not taken during a write\n", t);
       continue;
     }
     ++matched;
     first = std::min(first, k);
-    if (received) std::fprintf(received, "%zu\n", k);
+    if (received) std::fprintf(received, "%zu %.6f\n", k, t);
   }
   if (received) std::fclose(received);
   const std::size_t sent_from_first = first < sent.size() ? sent.size() - first : 0;
-  std::printf("first_frame %zu live_frames %zu matched %zu unmatched %zu sent_from_first %zu lost %ld\n", first,
-              live.size(), matched, unmatched, sent_from_first, long(sent_from_first) - long(matched));
+  std::printf("first_frame %zu live_frames %zu matched %zu unmatched %zu restamped %zu sent_from_first %zu lost %ld\n",
+              first, live.size(), matched, unmatched, restamped, sent_from_first, long(sent_from_first) - long(matched));
   return unmatched == 0 ? 0 : 1;
 }
 
-// The frames of a recording whose sequence numbers are listed (one per line), in a new recording:
-// the replay of exactly the frames a live run received.
+// The frames of a recording whose sequence numbers are listed with the stamps the live run saw.
 int select(const std::string& recording, const std::string& indices_path, const std::string& out_path) {
-  std::vector<uint64_t> wanted;
+  std::vector<std::pair<uint64_t, double>> wanted;  // index, live stamp
   std::ifstream indices(indices_path);
-  for (uint64_t k; indices >> k;) wanted.push_back(k);
+  uint64_t k = 0;
+  double stamp = 0;
+  while (indices >> k >> stamp) wanted.emplace_back(k, stamp);
   std::unique_ptr<plumb::RecordingSource> source;
   Status st = plumb::RecordingSource::open(recording, &source);
   std::unique_ptr<plumb::RecordingWriter> writer;
@@ -333,7 +349,11 @@ int select(const std::string& recording, const std::string& indices_path, const 
       st = source->lastError();
       break;
     }
-    if (std::find(wanted.begin(), wanted.end(), frame.sequence) == wanted.end()) continue;
+    const auto it = std::find_if(wanted.begin(), wanted.end(),
+                                 [&](const std::pair<uint64_t, double>& w) { return w.first == frame.sequence; });
+    if (it == wanted.end()) continue;
+    frame.depth_timestamp_s += it->second - frame.timestamp_s;  // keep the colour-depth offset
+    frame.timestamp_s = it->second;
     st = writer->append(frame);
     ++kept;
   }
