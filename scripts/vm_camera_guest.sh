@@ -119,7 +119,7 @@ loopback_check() {
   d=/tmp/loop
   mkdir -p $d
   plumb_vmcam_feeder feed --source /vmcam/synth --colour /dev/video10 --depth /dev/video11 \
-    --out-dir $d --fps "$FPS" >$d/feeder.log 2>&1 &
+    --out-dir $d --fps "$FPS" --linger 600 >$d/feeder.log 2>&1 &
   feeder=$!
   # The capture side exists once the feeder has written a frame (exclusive_caps).
   i=0
@@ -132,13 +132,29 @@ loopback_check() {
   plumb run --dataset v4l2:/dev/video10,/dev/video11 --camera $d/camera.txt --out $d/live.txt \
     >$d/live.log 2>&1 &
   live=$!
-  # The feeder keeps its outputs open 2.5 s after the last frame: plumb takes what the driver
-  # still holds meanwhile (its stall timeout is 3 s). Then plumb is stopped as an operator would.
-  wait $feeder
-  check "feeder wrote every frame ($(cat $d/feeder.log))" [ $? -eq 0 ]
+  # After the last frame the feeder keeps its outputs open (the node stays a capture device) while
+  # plumb takes what the driver still holds; once plumb is idle (no CPU time for 1 s: waiting for
+  # a frame; well inside its 3 s stall timeout), it is stopped as an operator would.
+  i=0
+  while ! grep -q "feeder: wrote" $d/feeder.log && kill -0 $feeder 2>/dev/null && [ $i -lt 3000 ]; do
+    sleep 0.2
+    i=$((i + 1))
+  done
+  check "feeder wrote every frame ($(cat $d/feeder.log))" grep -q "feeder: wrote" $d/feeder.log
+  cpu() { awk '{ print $14 + $15 }' /proc/$live/stat 2>/dev/null; }
+  last=$(cpu)
+  idle=0
+  while [ $idle -lt 2 ] && [ -n "$last" ]; do
+    sleep 0.5
+    c=$(cpu)
+    if [ "$c" = "$last" ]; then idle=$((idle + 1)); else idle=0; fi
+    last=$c
+  done
   kill -INT $live
   wait $live
   live_status=$?
+  kill $feeder
+  wait $feeder
   cat $d/live.log
   check "live run stopped cleanly by SIGINT (exit $live_status, 3 expected)" [ $live_status -eq 3 ]
   match=$(plumb_vmcam_feeder match --sent $d/sent.txt --trajectory $d/live.txt --received-out $d/received.txt)

@@ -133,7 +133,7 @@ if [ "$accel" = kvm ]; then
   guest_fps=10 guest_frames=120 timeout_s="${PLUMB_VM_TIMEOUT:-480}"
 else
   accel_flags=(-accel tcg -cpu max)
-  guest_fps=2 guest_frames=40 timeout_s="${PLUMB_VM_TIMEOUT:-1500}"
+  guest_fps=1 guest_frames=30 timeout_s="${PLUMB_VM_TIMEOUT:-1500}"
 fi
 t0=$(date +%s.%N)
 synth="$work/synth-$guest_frames"

@@ -131,8 +131,9 @@ struct FeedOptions {
   std::string source, colour, depth, out_dir, gt;
   double fps = 10;
   long frames = -1;
-  // Seconds the outputs stay open after the last frame: v4l2loopback (exclusive_caps) stops being
-  // a capture device when its writer closes, so the reader gets this long to take what is queued.
+  // Seconds the outputs stay open after the last frame (the summary line and every file are
+  // written before): v4l2loopback (exclusive_caps) stops being a capture device when its writer
+  // closes, so a reader still taking what is queued needs the writer to stay.
   double linger_s = 2.5;
 };
 
@@ -239,14 +240,15 @@ Status feed(const FeedOptions& o) {
     }
   }
   std::fclose(sent);
-  timespec linger{time_t(o.linger_s), long((o.linger_s - double(time_t(o.linger_s))) * 1e9)};
-  nanosleep(&linger, nullptr);
-  close(colour_fd);
-  close(depth_fd);
   PLUMB_RETURN_IF_ERROR(replay->close());
   if (!truth.empty()) PLUMB_RETURN_IF_ERROR(plumb::writeTumTrajectory(o.out_dir + "/groundtruth.txt", truth));
   std::printf("feeder: wrote %zu frames at %.1f Hz (loading %.0f ms/frame, at most %.1f ms late)\n", frames.size(),
               o.fps, frames.empty() ? 0.0 : load_ms / double(frames.size()), late_ns * 1e-6);
+  std::fflush(stdout);
+  timespec linger{time_t(o.linger_s), long((o.linger_s - double(time_t(o.linger_s))) * 1e9)};
+  nanosleep(&linger, nullptr);
+  close(colour_fd);
+  close(depth_fd);
   return Status::Ok();
 }
 

@@ -166,7 +166,9 @@ bool V4l2Source::convert(RgbdImage& out) {
   // Sequence: driver counter differences within a session; across a reopen, the time gap.
   uint64_t step = 1;
   if (have_last_ && reopened_) {
-    const double period_ns = 1e9 / options_.fps;
+    // The frame period the camera really kept (a camera may run slower than asked), else the
+    // nominal one.
+    const double period_ns = observed_period_ns_ > 0 ? observed_period_ns_ : 1e9 / options_.fps;
     step = static_cast<uint64_t>(
         std::max(1.0, std::round((c.timestamp_ns - last_timestamp_ns_) / period_ns)));
   } else if (have_last_) {
@@ -174,6 +176,9 @@ bool V4l2Source::convert(RgbdImage& out) {
     // A step of 0 or one that looks backwards (over half the range) is a restarted counter.
     const uint32_t driver_step = c.sequence - last_driver_sequence_;
     if (driver_step > 0 && driver_step < 0x80000000u) step = driver_step;
+    const double period_ns = double(c.timestamp_ns - last_timestamp_ns_) / double(step);
+    if (period_ns > 0)  // a running mean over ~10 frames
+      observed_period_ns_ = observed_period_ns_ > 0 ? 0.9 * observed_period_ns_ + 0.1 * period_ns : period_ns;
   }
   out.sequence = have_last_ ? last_sequence_ + step : 0;
   have_last_ = true;

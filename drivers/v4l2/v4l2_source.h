@@ -73,6 +73,7 @@ class V4l2Source : public FrameSource {
   uint64_t last_sequence_ = 0;
   int64_t last_timestamp_ns_ = 0;
   uint32_t last_driver_sequence_ = 0;
+  double observed_period_ns_ = 0;  // running mean of the delivered frames' period, 0 = none yet
   bool reopened_ = false;
   V4l2PairingStats stats_;
 };

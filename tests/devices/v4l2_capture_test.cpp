@@ -260,6 +260,23 @@ TEST(V4l2DriverFaults, AStreamingErrorIsReportedAsSuchAndTheNodeRecovers) {
   ASSERT_EQ(source->next(out), SourceResult::kFrame);
 }
 
+TEST(V4l2DriverFaults, FramesLostAcrossAReopenAreCountedAtTheRateTheCameraKept) {
+  FakeV4l2Device fake;
+  fake.nodes["/dev/video0"] = colourNode();
+  fake.nodes["/dev/video0"].period_ns = 500'000'000;  // 2 Hz, though 30 Hz was asked for
+  fake.nodes["/dev/video0"].unplug_after_dequeues = 4;
+  std::unique_ptr<V4l2Source> source;
+  ASSERT_TRUE(V4l2Source::open({}, camera4x2(), fake, &source).ok());
+  RgbdImage out;
+  for (int i = 0; i < 4; ++i) ASSERT_EQ(source->next(out), SourceResult::kFrame);
+  ASSERT_EQ(source->next(out), SourceResult::kError);
+  fake.nodes["/dev/video0"].unplugged = false;
+  fake.nodes["/dev/video0"].produced += 3;  // 3 frames (1.5 s) pass while it is away
+  ASSERT_TRUE(source->reopen().ok());
+  ASSERT_EQ(source->next(out), SourceResult::kFrame);
+  EXPECT_EQ(out.sequence, 3u + 4u) << "3 frames missing, not the 45 a 30 Hz guess would claim";
+}
+
 TEST(V4l2DriverFaults, DepthMayComeAsY16) {
   FakeV4l2Device fake;
   fake.nodes["/dev/video0"] = colourNode();
