@@ -4,7 +4,7 @@
 //
 //   plumb_vmcam_feeder feed --source SPEC --colour DEV --depth DEV --out-dir DIR
 //                           [--fps F (10)] [--frames N (all)] [--gt FILE (SPEC/groundtruth.txt)]
-//                           [--linger S (2.5)]
+//                           [--hold 1] [--wait-for FILE]
 //   plumb_vmcam_feeder match --sent DIR/sent.txt --trajectory TRAJ [--received-out FILE]
 //   plumb_vmcam_feeder select --recording REC --indices FILE --out OUT
 //
@@ -21,11 +21,11 @@
 //   sent.txt         `index t_colour t_depth t_colour_start` per frame (CLOCK_MONOTONIC seconds: when
 //                    each write() returned, and when the colour write() started).
 // The stamps of the replay and of groundtruth.txt are when the colour write() returned, within a
-// write's duration of the driver's own stamp. The outputs stay open --linger S (2.5) seconds after
-// the last frame.
-// match: which sent frame the trajectory starts at, and how many sent frames after it have no
-// trajectory line (lost on the way). Prints `first_frame K live_frames M matched M unmatched U
-// restamped R sent_from_first S lost L` (R: see the v4l2loopback REQBUFS quirk in match());
+// write's duration of the driver's own stamp. --hold 1: after the last frame, it is sent again and
+// again (indices N, N+1, ...; in every output file too) until SIGTERM, which ends the feed cleanly.
+// match: which sent frames the trajectory starts and ends at, and how many sent between them have
+// no trajectory line (lost on the way). Prints `first_frame K last_frame J live_frames M matched M
+// unmatched U restamped R lost L` (R: see the v4l2loopback REQBUFS quirk in match());
 // --received-out lists `index live_stamp` for the frames the trajectory has.
 // select: the frames of REC whose sequence numbers FILE lists (`index live_stamp` lines, as match
 // writes them), stamped with the live stamps, as recording OUT: the replay of exactly the frames
@@ -38,6 +38,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
@@ -58,6 +59,9 @@
 namespace {
 
 using plumb::Status;
+
+volatile std::sig_atomic_t g_stop_requested = 0;
+void requestStop(int) { g_stop_requested = 1; }
 
 int64_t monotonicNs() {
   timespec t{};
@@ -131,10 +135,15 @@ struct FeedOptions {
   std::string source, colour, depth, out_dir, gt;
   double fps = 10;
   long frames = -1;
-  // Seconds the outputs stay open after the last frame (the summary line and every file are
-  // written before): v4l2loopback (exclusive_caps) stops being a capture device when its writer
-  // closes, so a reader still taking what is queued needs the writer to stay.
-  double linger_s = 2.5;
+  // After the last frame, keep sending it (the camera goes on looking at its last view) until
+  // SIGTERM: the reader never starves, so its stall timeout never reopens the node (v4l2loopback
+  // would then hand out an old frame with a new stamp), and v4l2loopback (exclusive_caps) stays a
+  // capture device while the reader takes what is queued.
+  bool hold = false;
+  // After frame 0 (which makes the loopback devices capture devices), wait until this file exists
+  // before going on: the reader has then asked for buffers (v4l2loopback re-stamps every buffer at
+  // a reader's VIDIOC_REQBUFS, so only frame 0 can carry that time) and is streaming.
+  std::string wait_for;
 };
 
 // One frame as it goes out: YUYV colour and depth in millimetres, and its true pose if known.
@@ -211,8 +220,9 @@ Status feed(const FeedOptions& o) {
   std::vector<plumb::StampedPose> truth;
   int64_t due_ns = monotonicNs();
   int64_t late_ns = 0;
-  for (std::size_t index = 0; index < frames.size(); ++index) {
-    const OutgoingFrame& f = frames[index];
+  std::size_t index = 0;
+  for (; !frames.empty() && g_stop_requested == 0 && (index < frames.size() || o.hold); ++index) {
+    const OutgoingFrame& f = frames[std::min(index, frames.size() - 1)];
     // Absolute schedule: no drift; a late frame goes at once and is counted.
     timespec due{time_t(due_ns / 1000000000), long(due_ns % 1000000000)};
     clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &due, nullptr);
@@ -233,22 +243,31 @@ Status feed(const FeedOptions& o) {
     decoded.t_sensor_ns = t_colour;
     decoded.depth_factor = 1000.0;
     PLUMB_RETURN_IF_ERROR(replay->append(decoded));
+    if (index == 0 && !o.wait_for.empty()) {
+      while (!std::ifstream(o.wait_for).good()) {
+        timespec poll_interval{0, 50'000'000};
+        nanosleep(&poll_interval, nullptr);
+      }
+      due_ns = monotonicNs() + period_ns;
+    }
     if (f.has_truth) {
       plumb::StampedPose pose = f.truth;
       pose.timestamp = t_colour * 1e-9;
       truth.push_back(pose);
     }
+    if (index + 1 == frames.size()) {
+      std::printf("feeder: wrote %zu frames at %.1f Hz (loading %.0f ms/frame, at most %.1f ms late)%s\n",
+                  frames.size(), o.fps, load_ms / double(frames.size()), late_ns * 1e-6,
+                  o.hold ? "; holding the last view" : "");
+      std::fflush(stdout);
+    }
   }
   std::fclose(sent);
-  PLUMB_RETURN_IF_ERROR(replay->close());
-  if (!truth.empty()) PLUMB_RETURN_IF_ERROR(plumb::writeTumTrajectory(o.out_dir + "/groundtruth.txt", truth));
-  std::printf("feeder: wrote %zu frames at %.1f Hz (loading %.0f ms/frame, at most %.1f ms late)\n", frames.size(),
-              o.fps, frames.empty() ? 0.0 : load_ms / double(frames.size()), late_ns * 1e-6);
-  std::fflush(stdout);
-  timespec linger{time_t(o.linger_s), long((o.linger_s - double(time_t(o.linger_s))) * 1e9)};
-  nanosleep(&linger, nullptr);
   close(colour_fd);
   close(depth_fd);
+  PLUMB_RETURN_IF_ERROR(replay->close());
+  if (!truth.empty()) PLUMB_RETURN_IF_ERROR(plumb::writeTumTrajectory(o.out_dir + "/groundtruth.txt", truth));
+  if (index > frames.size()) std::printf("feeder: then %zu frames of the last view\n", index - frames.size());
   return Status::Ok();
 }
 
@@ -296,16 +315,15 @@ int match(const std::string& sent_path, const std::string& trajectory_path, cons
   // A live stamp is a sent frame's when the driver took it during that frame's write() (1 ms of
   // slack for the trajectory's microsecond rounding).
   // One exception, a v4l2loopback 0.12 quirk: VIDIOC_REQBUFS re-stamps every buffer with the
-  // current time (init_buffers), so the first frame a new reader takes, written before it asked for
-  // buffers, carries the time of that request. Such a first stamp, after write k and before write
-  // k+1, is frame k, counted apart as "restamped".
-  std::size_t first = sent.size(), matched = 0, unmatched = 0, restamped = 0;
+  // current time (init_buffers), so the first frame a reader takes after it asked for buffers (at
+  // the start, and after a reopen) carries the time of that request. A stamp after write k and
+  // before write k+1 is frame k, counted apart as "restamped" (the bench allows one per REQBUFS).
+  std::size_t first = sent.size(), last = 0, matched = 0, unmatched = 0, restamped = 0;
   std::FILE* received = received_out.empty() ? nullptr : std::fopen(received_out.c_str(), "w");
-  for (std::size_t i = 0; i < live.size(); ++i) {
-    const double t = live[i];
+  for (const double t : live) {
     std::size_t k = 0;
     while (k < sent.size() && !(t >= sent[k].start - 1e-3 && t <= sent[k].end + 1e-3)) ++k;
-    if (k == sent.size() && i == 0) {
+    if (k == sent.size()) {
       std::size_t before = 0;
       while (before + 1 < sent.size() && sent[before + 1].start <= t) ++before;
       if (t > sent[before].end && (before + 1 == sent.size() || t < sent[before + 1].start)) {
@@ -319,12 +337,15 @@ int match(const std::string& sent_path, const std::string& trajectory_path, cons
     }
     ++matched;
     first = std::min(first, k);
+    last = std::max(last, k);
     if (received) std::fprintf(received, "%zu %.6f\n", k, t);
   }
   if (received) std::fclose(received);
-  const std::size_t sent_from_first = first < sent.size() ? sent.size() - first : 0;
-  std::printf("first_frame %zu live_frames %zu matched %zu unmatched %zu restamped %zu sent_from_first %zu lost %ld\n",
-              first, live.size(), matched, unmatched, restamped, sent_from_first, long(sent_from_first) - long(matched));
+  // Lost: frames sent between the first and the last one received that never arrived (frames after
+  // the last one were not lost: the run was stopped).
+  const std::size_t span = first <= last ? last - first + 1 : 0;
+  std::printf("first_frame %zu last_frame %zu live_frames %zu matched %zu unmatched %zu restamped %zu lost %ld\n",
+              first, last, live.size(), matched, unmatched, restamped, long(span) - long(matched));
   return unmatched == 0 ? 0 : 1;
 }
 
@@ -383,7 +404,8 @@ int main(int argc, char** argv) {
     else if (key == "--fps") feed_options.fps = std::atof(value.c_str());
     else if (key == "--frames") feed_options.frames = std::atol(value.c_str());
     else if (key == "--gt") feed_options.gt = value;
-    else if (key == "--linger") feed_options.linger_s = std::atof(value.c_str());
+    else if (key == "--hold") feed_options.hold = value == "1";
+    else if (key == "--wait-for") feed_options.wait_for = value;
     else if (key == "--sent") sent = value;
     else if (key == "--trajectory") trajectory = value;
     else if (key == "--received-out") received_out = value;
@@ -397,6 +419,7 @@ int main(int argc, char** argv) {
   }
   if (command == "feed" && !feed_options.source.empty() && !feed_options.colour.empty() &&
       !feed_options.depth.empty() && !feed_options.out_dir.empty() && feed_options.fps > 0) {
+    std::signal(SIGTERM, requestStop);
     const Status st = feed(feed_options);
     if (!st.ok()) std::fprintf(stderr, "feeder: %s\n", st.message().c_str());
     return st.ok() ? 0 : 1;

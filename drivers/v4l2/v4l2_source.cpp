@@ -176,7 +176,13 @@ bool V4l2Source::convert(RgbdImage& out) {
     // A step of 0 or one that looks backwards (over half the range) is a restarted counter.
     const uint32_t driver_step = c.sequence - last_driver_sequence_;
     if (driver_step > 0 && driver_step < 0x80000000u) step = driver_step;
-    const double period_ns = double(c.timestamp_ns - last_timestamp_ns_) / double(step);
+    // A camera cannot have made more frames than fit in the time between the two stamps (at up to
+    // twice the rate it kept): a larger jump is a counter that restarted (v4l2loopback numbers the
+    // first frame after a reader's VIDIOC_REQBUFS 0), not lost frames.
+    const int64_t elapsed_ns = c.timestamp_ns - last_timestamp_ns_;
+    if (observed_period_ns_ > 0 && elapsed_ns > 0)
+      step = std::min<uint64_t>(step, std::max<uint64_t>(1, uint64_t(2.0 * elapsed_ns / observed_period_ns_)));
+    const double period_ns = double(elapsed_ns) / double(step);
     if (period_ns > 0)  // a running mean over ~10 frames
       observed_period_ns_ = observed_period_ns_ > 0 ? 0.9 * observed_period_ns_ + 0.1 * period_ns : period_ns;
   }

@@ -277,6 +277,22 @@ TEST(V4l2DriverFaults, FramesLostAcrossAReopenAreCountedAtTheRateTheCameraKept) 
   EXPECT_EQ(out.sequence, 3u + 4u) << "3 frames missing, not the 45 a 30 Hz guess would claim";
 }
 
+TEST(V4l2DriverFaults, ACounterJumpFasterThanTheCameraRunsIsNotCountedAsLoss) {
+  FakeV4l2Device fake;
+  fake.nodes["/dev/video0"] = colourNode();
+  std::unique_ptr<V4l2Source> source;
+  ASSERT_TRUE(V4l2Source::open({}, camera4x2(), fake, &source).ok());
+  RgbdImage out;
+  for (int i = 0; i < 5; ++i) ASSERT_EQ(source->next(out), SourceResult::kFrame);
+  EXPECT_EQ(out.sequence, 4u);
+  fake.nodes["/dev/video0"].first_sequence = 100;  // the counter jumps; one frame period passed
+  ASSERT_EQ(source->next(out), SourceResult::kFrame);
+  EXPECT_EQ(out.sequence, 5u) << "not 100 frames lost in 33 ms";
+  fake.nodes["/dev/video0"].produced += 2;  // a real drop: 2 frames, 3 periods
+  ASSERT_EQ(source->next(out), SourceResult::kFrame);
+  EXPECT_EQ(out.sequence, 8u);
+}
+
 TEST(V4l2DriverFaults, DepthMayComeAsY16) {
   FakeV4l2Device fake;
   fake.nodes["/dev/video0"] = colourNode();
