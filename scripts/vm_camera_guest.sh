@@ -134,14 +134,13 @@ loopback_check() {
   plumb run --dataset v4l2:/dev/video10,/dev/video11 --camera $d/camera.txt --out $d/live.txt \
     >$d/live.log 2>&1 &
   live=$!
-  # The rest of the sequence once plumb has mapped the depth node's buffers (both nodes are then
-  # set up; it streams right after).
+  # The feeder shows its first view until plumb has mapped the depth node's buffers (both nodes
+  # are then set up; it streams right after), then plays the sequence.
   i=0
   while ! grep -q /dev/video11 /proc/$live/maps 2>/dev/null && kill -0 $live 2>/dev/null && [ $i -lt 600 ]; do
     sleep 0.1
     i=$((i + 1))
   done
-  sleep 0.5
   touch $d/go
   # After the last frame the feeder keeps sending it (the camera goes on looking at its last
   # view); plumb gets a few frame periods to take what is queued, then it is stopped as an

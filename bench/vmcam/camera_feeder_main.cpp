@@ -21,8 +21,9 @@
 //   sent.txt         `index t_colour t_depth t_colour_start` per frame (CLOCK_MONOTONIC seconds: when
 //                    each write() returned, and when the colour write() started).
 // The stamps of the replay and of groundtruth.txt are when the colour write() returned, within a
-// write's duration of the driver's own stamp. --hold 1: after the last frame, it is sent again and
-// again (indices N, N+1, ...; in every output file too) until SIGTERM, which ends the feed cleanly.
+// write's duration of the driver's own stamp. Every write has its own index in every output file:
+// --wait-for repeats frame 0 until the file exists, --hold 1 repeats the last frame after the
+// sequence until SIGTERM (which ends the feed cleanly).
 // match: which sent frames the trajectory starts and ends at, and how many sent between them have
 // no trajectory line (lost on the way). Prints `first_frame K last_frame J live_frames M matched M
 // unmatched U restamped R lost L` (R: see the v4l2loopback REQBUFS quirk in match());
@@ -39,6 +40,7 @@
 #include <cerrno>
 #include <cmath>
 #include <csignal>
+#include <cstdlib>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
@@ -46,6 +48,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "drivers/dataset/camera_file.h"
@@ -140,9 +143,8 @@ struct FeedOptions {
   // would then hand out an old frame with a new stamp), and v4l2loopback (exclusive_caps) stays a
   // capture device while the reader takes what is queued.
   bool hold = false;
-  // After frame 0 (which makes the loopback devices capture devices), wait until this file exists
-  // before going on: the reader has then asked for buffers (v4l2loopback re-stamps every buffer at
-  // a reader's VIDIOC_REQBUFS, so only frame 0 can carry that time) and is streaming.
+  // Send frame 0 (the first one makes the loopback devices capture devices) again and again until
+  // this file exists: the reader then streams and sees the whole sequence, never starving before.
   std::string wait_for;
 };
 
@@ -220,18 +222,32 @@ Status feed(const FeedOptions& o) {
   std::vector<plumb::StampedPose> truth;
   int64_t due_ns = monotonicNs();
   int64_t late_ns = 0;
-  std::size_t index = 0;
-  for (; !frames.empty() && g_stop_requested == 0 && (index < frames.size() || o.hold); ++index) {
-    const OutgoingFrame& f = frames[std::min(index, frames.size() - 1)];
+  int64_t max_skew_ns = 0;  // between the colour and the depth write of one frame
+  // index counts writes; frame is the recording's frame sent with it: frame 0 until --wait-for's
+  // file exists (the camera looks at its first view until the reader streams), then one per
+  // write, then (--hold) the last one until SIGTERM.
+  std::size_t index = 0, frame = 0, first_view_writes = 0, last_view_writes = 0;
+  bool started = o.wait_for.empty(), summarised = false;
+  for (; !frames.empty() && g_stop_requested == 0; ++index) {
+    const OutgoingFrame& f = frames[frame];
     // Absolute schedule: no drift; a late frame goes at once and is counted.
     timespec due{time_t(due_ns / 1000000000), long(due_ns % 1000000000)};
     clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &due, nullptr);
     late_ns = std::max(late_ns, monotonicNs() - due_ns);
     due_ns += period_ns;
+    // Colour and depth are written at the same time, from two threads, like a camera whose
+    // sensors are synchronised: their stamps differ by little more than the two copies do.
     int64_t t_colour_start = 0, t_colour = 0, t_depth_start = 0, t_depth = 0;
-    PLUMB_RETURN_IF_ERROR(writeFrame(colour_fd, o.colour, f.yuyv.data(), f.yuyv.size(), &t_colour_start, &t_colour));
-    PLUMB_RETURN_IF_ERROR(
-        writeFrame(depth_fd, o.depth, f.depth_mm.data, f.depth_mm.total() * 2, &t_depth_start, &t_depth));
+    Status depth_status;
+    std::thread depth_writer([&] {
+      depth_status = writeFrame(depth_fd, o.depth, f.depth_mm.data, f.depth_mm.total() * 2, &t_depth_start, &t_depth);
+    });
+    const Status colour_status =
+        writeFrame(colour_fd, o.colour, f.yuyv.data(), f.yuyv.size(), &t_colour_start, &t_colour);
+    depth_writer.join();
+    PLUMB_RETURN_IF_ERROR(colour_status);
+    PLUMB_RETURN_IF_ERROR(depth_status);
+    max_skew_ns = std::max<int64_t>(max_skew_ns, std::llabs(t_depth - t_colour));
     std::fprintf(sent, "%zu %.6f %.6f %.6f\n", index, t_colour * 1e-9, t_depth * 1e-9, t_colour_start * 1e-9);
     std::fflush(sent);
     // The replay gets exactly what plumb decodes, stamped like the live frames.
@@ -243,23 +259,30 @@ Status feed(const FeedOptions& o) {
     decoded.t_sensor_ns = t_colour;
     decoded.depth_factor = 1000.0;
     PLUMB_RETURN_IF_ERROR(replay->append(decoded));
-    if (index == 0 && !o.wait_for.empty()) {
-      while (!std::ifstream(o.wait_for).good()) {
-        timespec poll_interval{0, 50'000'000};
-        nanosleep(&poll_interval, nullptr);
-      }
-      due_ns = monotonicNs() + period_ns;
-    }
     if (f.has_truth) {
       plumb::StampedPose pose = f.truth;
       pose.timestamp = t_colour * 1e-9;
       truth.push_back(pose);
     }
-    if (index + 1 == frames.size()) {
-      std::printf("feeder: wrote %zu frames at %.1f Hz (loading %.0f ms/frame, at most %.1f ms late)%s\n",
-                  frames.size(), o.fps, load_ms / double(frames.size()), late_ns * 1e-6,
-                  o.hold ? "; holding the last view" : "");
+    if (frame + 1 == frames.size() && summarised) ++last_view_writes;
+    if (frame + 1 == frames.size() && !summarised) {
+      std::printf(
+          "feeder: wrote %zu frames at %.1f Hz (loading %.0f ms/frame, at most %.1f ms late, colour-depth skew at "
+          "most %.1f ms; the first view %zu times)%s\n",
+          frames.size(), o.fps, load_ms / double(frames.size()), late_ns * 1e-6, max_skew_ns * 1e-6,
+          first_view_writes, o.hold ? "; holding the last view" : "");
       std::fflush(stdout);
+      summarised = true;
+    }
+    if (!started) {
+      ++first_view_writes;
+      started = std::ifstream(o.wait_for).good();
+      if (!started) continue;
+    }
+    if (frame + 1 < frames.size()) {
+      ++frame;
+    } else if (!o.hold) {
+      break;
     }
   }
   std::fclose(sent);
@@ -267,7 +290,7 @@ Status feed(const FeedOptions& o) {
   close(depth_fd);
   PLUMB_RETURN_IF_ERROR(replay->close());
   if (!truth.empty()) PLUMB_RETURN_IF_ERROR(plumb::writeTumTrajectory(o.out_dir + "/groundtruth.txt", truth));
-  if (index > frames.size()) std::printf("feeder: then %zu frames of the last view\n", index - frames.size());
+  if (last_view_writes > 0) std::printf("feeder: then %zu frames of the last view\n", last_view_writes);
   return Status::Ok();
 }
 

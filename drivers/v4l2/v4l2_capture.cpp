@@ -80,6 +80,7 @@ Status V4l2Capture::fail(const char* what, int error_number) const {
 Status V4l2Capture::open(const V4l2CaptureOptions& options) {
   close();
   options_ = options;
+  have_previous_ = false;
   if (options.buffer_count < 2 || options.buffer_count > kMaxBuffers)
     return Status::Error(options.device_path + ": buffer_count must be 2.." +
                          std::to_string(kMaxBuffers));
@@ -259,6 +260,15 @@ SourceResult V4l2Capture::dequeue(V4l2FrameView* view, Status* error) {
   }
   view->sequence = buf.sequence;
   ++counters_.buffers;
+  const uint32_t step = buf.sequence - previous_sequence_;
+  const int64_t elapsed_ns = view->timestamp_ns - previous_stamp_ns_;
+  if (have_previous_ && step >= 1 && step <= 64 && elapsed_ns > 0) {
+    const double period_ns = double(elapsed_ns) / step;
+    observed_period_ns_ = observed_period_ns_ > 0 ? 0.9 * observed_period_ns_ + 0.1 * period_ns : period_ns;
+  }
+  have_previous_ = true;
+  previous_stamp_ns_ = view->timestamp_ns;
+  previous_sequence_ = buf.sequence;
   return SourceResult::kFrame;
 }
 

@@ -80,6 +80,10 @@ class V4l2Capture {
   // The format the driver streams (options().format, or kY16 standing in for kZ16).
   V4l2PixelFormat format() const { return format_; }
   const V4l2CaptureCounters& counters() const { return counters_; }
+  // The node's frame period as its buffers show it (stamp difference over sequence difference, a
+  // running mean over ~10 buffers; kept across reopens), 0 until two buffers were seen. Cameras
+  // may run slower than the rate asked with VIDIOC_S_PARM, which drivers are free to ignore.
+  double observedPeriodNs() const { return observed_period_ns_; }
 
  private:
   struct MappedBuffer {
@@ -97,6 +101,10 @@ class V4l2Capture {
   bool streaming_ = false;
   V4l2PixelFormat format_ = V4l2PixelFormat::kYuyv;
   V4l2CaptureCounters counters_;
+  bool have_previous_ = false;  // a buffer was delivered since open()
+  int64_t previous_stamp_ns_ = 0;
+  uint32_t previous_sequence_ = 0;
+  double observed_period_ns_ = 0;
   std::size_t stride_ = 0;
   FixedVector<MappedBuffer, kMaxBuffers> buffers_;
   int dequeued_index_ = -1;  // buffer held by the caller, -1 = none

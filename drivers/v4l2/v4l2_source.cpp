@@ -51,6 +51,15 @@ Status V4l2Source::openNodes() {
   return Status::Ok();
 }
 
+int64_t V4l2Source::pairWindowNs() const {
+  // Half the frame period the streams keep (16 ms at 30 Hz): a closer pair is the same instant,
+  // and no frame of the other stream can be closer; never below the configured minimum.
+  double period_ns = colour_.observedPeriodNs();
+  if (depth_.observedPeriodNs() > 0 && (period_ns <= 0 || depth_.observedPeriodNs() < period_ns))
+    period_ns = depth_.observedPeriodNs();
+  return std::max<int64_t>(options_.max_pair_dt_ns, int64_t(period_ns / 2));
+}
+
 std::string V4l2Source::healthReport() const {
   const V4l2CaptureCounters& c = colour_.counters();
   const V4l2CaptureCounters& d = depth_.counters();
@@ -107,7 +116,7 @@ SourceResult V4l2Source::next(RgbdImage& out) {
       holding_depth_ = true;
     }
     const int64_t dt_ns = paired_mode ? colour_view_.timestamp_ns - depth_view_.timestamp_ns : 0;
-    if (std::llabs(dt_ns) <= options_.max_pair_dt_ns) {
+    if (std::llabs(dt_ns) <= pairWindowNs()) {
       const bool converted = convert(out);
       holding_colour_ = holding_depth_ = false;
       Status st = colour_.requeue();
@@ -168,7 +177,7 @@ bool V4l2Source::convert(RgbdImage& out) {
   if (have_last_ && reopened_) {
     // The frame period the camera really kept (a camera may run slower than asked), else the
     // nominal one.
-    const double period_ns = observed_period_ns_ > 0 ? observed_period_ns_ : 1e9 / options_.fps;
+    const double period_ns = colour_.observedPeriodNs() > 0 ? colour_.observedPeriodNs() : 1e9 / options_.fps;
     step = static_cast<uint64_t>(
         std::max(1.0, std::round((c.timestamp_ns - last_timestamp_ns_) / period_ns)));
   } else if (have_last_) {
@@ -180,11 +189,9 @@ bool V4l2Source::convert(RgbdImage& out) {
     // twice the rate it kept): a larger jump is a counter that restarted (v4l2loopback numbers the
     // first frame after a reader's VIDIOC_REQBUFS 0), not lost frames.
     const int64_t elapsed_ns = c.timestamp_ns - last_timestamp_ns_;
-    if (observed_period_ns_ > 0 && elapsed_ns > 0)
-      step = std::min<uint64_t>(step, std::max<uint64_t>(1, uint64_t(2.0 * elapsed_ns / observed_period_ns_)));
-    const double period_ns = double(elapsed_ns) / double(step);
-    if (period_ns > 0)  // a running mean over ~10 frames
-      observed_period_ns_ = observed_period_ns_ > 0 ? 0.9 * observed_period_ns_ + 0.1 * period_ns : period_ns;
+    const double period_ns = colour_.observedPeriodNs();
+    if (period_ns > 0 && elapsed_ns > 0)
+      step = std::min<uint64_t>(step, std::max<uint64_t>(1, uint64_t(2.0 * elapsed_ns / period_ns)));
   }
   out.sequence = have_last_ ? last_sequence_ + step : 0;
   have_last_ = true;

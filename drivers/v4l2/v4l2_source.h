@@ -5,8 +5,8 @@
 //
 // Pairing: by the buffers' kernel timestamps (CLOCK_MONOTONIC, checked per buffer: see
 // timestampOnMonotonicClock). Hold one buffer of each node; when their timestamps differ by more
-// than max_pair_dt_ns, give back the older one and take the next from that node. Unpaired frames
-// are counted. Depth may come as Z16 or Y16 (same layout). V4L2 reports no intrinsics, so the
+// than half the frame period the nodes keep (at least max_pair_dt_ns), give back the older one and
+// take the next from that node. Unpaired frames are counted. Depth may come as Z16 or Y16 (same layout). V4L2 reports no intrinsics, so the
 // camera comes from a camera file or preset.
 #include <cstdint>
 #include <memory>
@@ -24,7 +24,8 @@ struct V4l2SourceOptions {
   int fps = 30;
   int buffer_count = 4;
   int poll_timeout_ms = 100;
-  // Half a frame period at 30 Hz: a closer pair is the same instant, a farther one is not.
+  // Pairing window: half the frame period the streams keep (observed), at least this: 16 ms is
+  // half a frame at 30 Hz. A closer pair is the same instant, a farther one is not.
   int64_t max_pair_dt_ns = 16'000'000;
   // Z16 units per metre: 1000 for millimetre depth (RealSense default depth unit).
   double depth_factor = 1000.0;
@@ -60,6 +61,7 @@ class V4l2Source : public FrameSource {
   Status openNodes();
   SourceResult fail(const Status& error);
   bool convert(RgbdImage& out);
+  int64_t pairWindowNs() const;
 
   V4l2SourceOptions options_;
   PinholeCamera camera_;
@@ -73,7 +75,6 @@ class V4l2Source : public FrameSource {
   uint64_t last_sequence_ = 0;
   int64_t last_timestamp_ns_ = 0;
   uint32_t last_driver_sequence_ = 0;
-  double observed_period_ns_ = 0;  // running mean of the delivered frames' period, 0 = none yet
   bool reopened_ = false;
   V4l2PairingStats stats_;
 };

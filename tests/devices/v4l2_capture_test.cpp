@@ -293,6 +293,27 @@ TEST(V4l2DriverFaults, ACounterJumpFasterThanTheCameraRunsIsNotCountedAsLoss) {
   EXPECT_EQ(out.sequence, 8u);
 }
 
+TEST(V4l2DriverFaults, ASlowCameraIsPairedWithinHalfItsFramePeriod) {
+  // 2 Hz streams whose depth comes 100 ms after colour (a guest under load, or unsynchronised
+  // sensors): half a 30 Hz frame would pair nothing; half of the period they keep pairs them all.
+  FakeV4l2Device fake;
+  fake.nodes["/dev/video0"] = colourNode();
+  fake.nodes["/dev/video0"].period_ns = 500'000'000;
+  fake.nodes["/dev/video1"] = depthNode(100'000'000);
+  fake.nodes["/dev/video1"].period_ns = 500'000'000;
+  V4l2SourceOptions options;
+  options.depth_device = "/dev/video1";
+  std::unique_ptr<V4l2Source> source;
+  ASSERT_TRUE(V4l2Source::open(options, camera4x2(), fake, &source).ok());
+  RgbdImage out;
+  int frames = 0;
+  for (int call = 0; call < 20 && frames < 6; ++call) frames += source->next(out) == SourceResult::kFrame;
+  EXPECT_EQ(frames, 6);
+  EXPECT_NEAR(out.depth_timestamp_s - out.timestamp_s, 0.1, 1e-6);
+  EXPECT_LE(source->pairingStats().unpaired_colour, 1u) << "only before the period is known";
+  EXPECT_LE(source->pairingStats().unpaired_depth, 1u);
+}
+
 TEST(V4l2DriverFaults, DepthMayComeAsY16) {
   FakeV4l2Device fake;
   fake.nodes["/dev/video0"] = colourNode();
