@@ -98,6 +98,7 @@ class FakeV4l2Device : public V4l2Device {
     note("poll");
     FakeV4l2Node* n = node(fd);
     if (!n) return fail(EBADF);
+    armQueueError(*n);
     if (n->queue_error) return fail(EIO);  // what the system device reports for POLLERR alone
     return n->queued.empty() ? 0 : 1;
   }
@@ -156,10 +157,7 @@ class FakeV4l2Device : public V4l2Device {
           return fail(ENODEV);
         }
         if (n->unplugged) return fail(ENODEV);
-        if (n->queue_error_after_dequeues >= 0 && n->dequeues >= n->queue_error_after_dequeues) {
-          n->queue_error = true;
-          n->queue_error_after_dequeues = -1;
-        }
+        armQueueError(*n);
         if (n->queue_error) return fail(EIO);
         if (!n->streaming || n->queued.empty()) return fail(EAGAIN);
         auto* buf = static_cast<v4l2_buffer*>(arg);
@@ -199,6 +197,12 @@ class FakeV4l2Device : public V4l2Device {
 
  private:
   static constexpr std::size_t kPage = 4096;
+  static void armQueueError(FakeV4l2Node& n) {
+    if (n.queue_error_after_dequeues >= 0 && n.dequeues >= n.queue_error_after_dequeues) {
+      n.queue_error = true;
+      n.queue_error_after_dequeues = -1;
+    }
+  }
   static int fail(int e) {
     errno = e;
     return -1;
