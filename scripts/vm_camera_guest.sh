@@ -104,7 +104,7 @@ vivid_check() {
   check "the REQBUFS and STREAMON errors failed a reopen each" [ "$(before "$health" "failed reopens")" -ge 2 ]
   check "wrapped timestamps replaced by the dequeue time, kernel stamps used otherwise" \
     [ "$(field "$health" "dequeue-time stamps")" -ge 1 ] && [ "$(field "$health" "dequeue-time stamps")" -lt "${frames:-0}" ]
-  check "frames kept coming after the reload" [ "${frames:-0}" -ge 100 ]
+  check "frames kept coming after the disconnect" [ "${frames:-0}" -ge 100 ]
   say "  vivid took $(since "$t0") s"
 }
 
