@@ -23,6 +23,8 @@
 #include <string>
 #include <vector>
 
+#include "bench/vmcam/retry_ioctl.h"
+
 namespace {
 
 // What the configfs function announces (scripts/vm_camera_guest.sh make_gadget): YUYV 320x240 at
@@ -33,13 +35,7 @@ constexpr uint32_t kInterval100ns = 666666;  // 15 Hz
 constexpr int kBuffers = 4;
 
 // Failure is a negative result: usb_f_uvc's VIDIOC_REQBUFS returns the buffer count (6.1).
-int xioctl(int fd, unsigned long request, void* arg) {
-  int r;
-  do {
-    r = ioctl(fd, request, arg);
-  } while (r == -1 && errno == EINTR);
-  return r;
-}
+using plumb::vmcam::retryIoctl;
 
 struct Gadget {
   int fd = -1;
@@ -76,7 +72,7 @@ struct Gadget {
     b.index = index;
     fill(buffers[index].first);
     b.bytesused = kFrameBytes;
-    if (xioctl(fd, VIDIOC_QBUF, &b) < 0) {
+    if (retryIoctl(fd, VIDIOC_QBUF, &b) < 0) {
       std::fprintf(stderr, "uvc gadget: VIDIOC_QBUF: %s\n", std::strerror(errno));
       return false;
     }
@@ -93,18 +89,18 @@ struct Gadget {
     fmt.fmt.pix.pixelformat = V4L2_PIX_FMT_YUYV;
     fmt.fmt.pix.field = V4L2_FIELD_NONE;
     fmt.fmt.pix.sizeimage = kFrameBytes;
-    if (xioctl(fd, VIDIOC_S_FMT, &fmt) < 0) return report("VIDIOC_S_FMT");
+    if (retryIoctl(fd, VIDIOC_S_FMT, &fmt) < 0) return report("VIDIOC_S_FMT");
     v4l2_requestbuffers req{};
     req.count = kBuffers;
     req.type = V4L2_BUF_TYPE_VIDEO_OUTPUT;
     req.memory = V4L2_MEMORY_MMAP;
-    if (xioctl(fd, VIDIOC_REQBUFS, &req) < 0) return report("VIDIOC_REQBUFS");
+    if (retryIoctl(fd, VIDIOC_REQBUFS, &req) < 0) return report("VIDIOC_REQBUFS");
     for (uint32_t i = 0; i < req.count; ++i) {
       v4l2_buffer b{};
       b.type = V4L2_BUF_TYPE_VIDEO_OUTPUT;
       b.memory = V4L2_MEMORY_MMAP;
       b.index = i;
-      if (xioctl(fd, VIDIOC_QUERYBUF, &b) < 0) return report("VIDIOC_QUERYBUF");
+      if (retryIoctl(fd, VIDIOC_QUERYBUF, &b) < 0) return report("VIDIOC_QUERYBUF");
       void* p = mmap(nullptr, b.length, PROT_READ | PROT_WRITE, MAP_SHARED, fd, b.m.offset);
       if (p == MAP_FAILED) return report("mmap");
       buffers.emplace_back(p, b.length);
@@ -112,7 +108,7 @@ struct Gadget {
     for (uint32_t i = 0; i < buffers.size(); ++i)
       if (!queue(i)) return false;
     int type = V4L2_BUF_TYPE_VIDEO_OUTPUT;
-    if (xioctl(fd, VIDIOC_STREAMON, &type) < 0) return report("VIDIOC_STREAMON");
+    if (retryIoctl(fd, VIDIOC_STREAMON, &type) < 0) return report("VIDIOC_STREAMON");
     streaming = true;
     std::printf("uvc gadget: host started streaming\n");
     return true;
@@ -120,13 +116,13 @@ struct Gadget {
 
   void streamOff() {
     int type = V4L2_BUF_TYPE_VIDEO_OUTPUT;
-    xioctl(fd, VIDIOC_STREAMOFF, &type);
+    retryIoctl(fd, VIDIOC_STREAMOFF, &type);
     for (auto& b : buffers) munmap(b.first, b.second);
     buffers.clear();
     v4l2_requestbuffers req{};
     req.type = V4L2_BUF_TYPE_VIDEO_OUTPUT;
     req.memory = V4L2_MEMORY_MMAP;
-    xioctl(fd, VIDIOC_REQBUFS, &req);
+    retryIoctl(fd, VIDIOC_REQBUFS, &req);
     if (streaming) std::printf("uvc gadget: host stopped streaming after %llu frames\n", (unsigned long long)frames);
     streaming = false;
   }
@@ -163,7 +159,7 @@ struct Gadget {
       resp.length = std::min<int>(req.wLength, sizeof c);
       std::memcpy(resp.data, &c, size_t(resp.length));
     }
-    if (xioctl(fd, UVCIOC_SEND_RESPONSE, &resp) < 0) report("UVCIOC_SEND_RESPONSE");
+    if (retryIoctl(fd, UVCIOC_SEND_RESPONSE, &resp) < 0) report("UVCIOC_SEND_RESPONSE");
   }
 };
 
@@ -190,7 +186,7 @@ int main(int argc, char** argv) {
                         UVC_EVENT_STREAMON, UVC_EVENT_STREAMOFF}) {
     v4l2_event_subscription sub{};
     sub.type = type;
-    if (xioctl(g.fd, VIDIOC_SUBSCRIBE_EVENT, &sub) < 0) return g.report("VIDIOC_SUBSCRIBE_EVENT") ? 0 : 1;
+    if (retryIoctl(g.fd, VIDIOC_SUBSCRIBE_EVENT, &sub) < 0) return g.report("VIDIOC_SUBSCRIBE_EVENT") ? 0 : 1;
   }
   std::printf("uvc gadget: serving %s\n", device.c_str());
   std::fflush(stdout);
@@ -200,7 +196,7 @@ int main(int argc, char** argv) {
     if (poll(&p, 1, 100) <= 0) continue;
     if (p.revents & POLLPRI) {
       v4l2_event ev{};
-      if (xioctl(g.fd, VIDIOC_DQEVENT, &ev) != 0) continue;
+      if (retryIoctl(g.fd, VIDIOC_DQEVENT, &ev) != 0) continue;
       const auto* uvc = reinterpret_cast<const uvc_event*>(&ev.u.data);
       switch (ev.type) {
         case UVC_EVENT_SETUP: g.setup(uvc->req); break;
@@ -217,7 +213,7 @@ int main(int argc, char** argv) {
       v4l2_buffer b{};
       b.type = V4L2_BUF_TYPE_VIDEO_OUTPUT;
       b.memory = V4L2_MEMORY_MMAP;
-      if (xioctl(g.fd, VIDIOC_DQBUF, &b) == 0) g.queue(b.index);
+      if (retryIoctl(g.fd, VIDIOC_DQBUF, &b) == 0) g.queue(b.index);
     }
     std::fflush(stdout);
   }

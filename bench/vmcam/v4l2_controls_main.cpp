@@ -15,6 +15,8 @@
 #include <cstring>
 #include <string>
 
+#include "bench/vmcam/retry_ioctl.h"
+
 namespace {
 
 const char* typeName(uint32_t type) {
@@ -38,20 +40,14 @@ bool isPlainValue(uint32_t type) {
          type == V4L2_CTRL_TYPE_INTEGER_MENU;
 }
 
-int xioctl(int fd, unsigned long request, void* arg) {
-  int r;
-  do {
-    r = ioctl(fd, request, arg);
-  } while (r == -1 && errno == EINTR);
-  return r;
-}
+using plumb::vmcam::retryIoctl;
 
 // Calls `visit` for every control the node has (VIDIOC_QUERY_EXT_CTRL with NEXT_CTRL).
 template <typename Visit>
 void forEachControl(int fd, Visit visit) {
   v4l2_query_ext_ctrl query{};
   query.id = V4L2_CTRL_FLAG_NEXT_CTRL | V4L2_CTRL_FLAG_NEXT_COMPOUND;
-  while (xioctl(fd, VIDIOC_QUERY_EXT_CTRL, &query) == 0) {
+  while (retryIoctl(fd, VIDIOC_QUERY_EXT_CTRL, &query) == 0) {
     if (!visit(query)) return;
     query.id |= V4L2_CTRL_FLAG_NEXT_CTRL | V4L2_CTRL_FLAG_NEXT_COMPOUND;
   }
@@ -62,7 +58,7 @@ int list(int fd) {
     long long value = 0;
     if (isPlainValue(q.type) && !(q.flags & V4L2_CTRL_FLAG_WRITE_ONLY)) {
       v4l2_control c{q.id, 0};
-      if (xioctl(fd, VIDIOC_G_CTRL, &c) == 0) value = c.value;
+      if (retryIoctl(fd, VIDIOC_G_CTRL, &c) == 0) value = c.value;
     }
     std::printf("0x%08x %-7s \"%s\" min %lld max %lld value %lld%s\n", q.id, typeName(q.type), q.name,
                 static_cast<long long>(q.minimum), static_cast<long long>(q.maximum), value,
@@ -86,7 +82,7 @@ int set(int fd, const char* device, const std::string& name, long value) {
     return 1;
   }
   v4l2_control c{id, static_cast<int32_t>(value)};
-  if (xioctl(fd, VIDIOC_S_CTRL, &c) != 0) {
+  if (retryIoctl(fd, VIDIOC_S_CTRL, &c) != 0) {
     std::fprintf(stderr, "%s: setting \"%s\" to %ld failed: %s\n", device, name.c_str(), value,
                  std::strerror(errno));
     return 1;
