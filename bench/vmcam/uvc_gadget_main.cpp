@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include "bench/vmcam/retry_ioctl.h"
+#include "retry_ioctl.h"
 
 namespace {
 

@@ -15,7 +15,7 @@
 #include <cstring>
 #include <string>
 
-#include "bench/vmcam/retry_ioctl.h"
+#include "retry_ioctl.h"
 
 namespace {
 
