@@ -30,6 +30,13 @@ TEST_PACKAGES=(
   libceres-dev  # plumb_bench_solver's and plumb_test_solver_ceres's oracle (never linked by the product)
   clang libclang-rt-14-dev  # fuzz targets (scripts/fuzz.sh): libFuzzer is in libclang-rt-14-dev
   nodejs npm  # the independent MAVLink decoder of tests/mavlink_node (node-mavlink, pinned)
+  # the virtual-machine camera bench (scripts/vm_camera_test.sh, ctest vm_camera).
+  # The guest kernel (linux-image-amd64's linux-image-6.1.*), its linux-headers and the
+  # v4l2loopback-dkms source are fetched by that script with `apt-get download` and unpacked into
+  # the build folder, never installed: they always match each other, and installing the dkms
+  # package would build a module for the host's kernels. gcc-12 and make (build-essential) build
+  # v4l2loopback; udev provides the udevd that carries hot-plug events to libusb in the guest.
+  qemu-system-x86 busybox-static kmod cpio udev
 )
 
 packages=("${PRODUCT_PACKAGES[@]}")

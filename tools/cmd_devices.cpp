@@ -80,8 +80,10 @@ int runDevices(int argc, char** argv) {
     else std::printf("usb: %s", plumb::describeCameras(monitor.cameras()).c_str());
     if (watch_s > 0) {
       st = monitor.start([](const plumb::CameraChange& change) {
-        std::printf("usb: %s %s\n", change.arrived ? "arrived" : "left",
-                    plumb::describeCamera(change.camera).c_str());
+        // The event's time on the steady clock (CLOCK_MONOTONIC), to measure replug delays.
+        const double t_s = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+        std::printf("usb: %s %s at %.3f s\n", change.arrived ? "arrived" : "left",
+                    plumb::describeCamera(change.camera).c_str(), t_s);
         std::fflush(stdout);
       });
       if (!st.ok()) {

@@ -117,6 +117,8 @@ int runRecord(int argc, char** argv) {
               g_stop_requested ? " (stopped by Ctrl-C)" : "");
   if (no_frame_results > 0)
     std::printf("source timeouts (no frame): %llu\n", static_cast<unsigned long long>(no_frame_results));
+  const std::string health = source->healthReport();
+  if (!health.empty()) std::printf("%s\n", health.c_str());
   const plumb::SourceDamage damage = source->damage();
   if (damage.any()) {
     std::fprintf(stderr,

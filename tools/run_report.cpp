@@ -166,6 +166,10 @@ int reportRun(const RunCommandOptions& o, const FlagTable& table, RunPlan& plan,
   } else if (!ex.map_note.empty() && ex.status.ok()) {
     std::fprintf(stderr, "plumb run: %s\n", ex.map_note.c_str());
   }
+  // Live sources: what supervision and capture counted (faults, reconnects, pairing), also after a
+  // failed run.
+  const std::string source_health = plan.source->healthReport();
+  if (!source_health.empty()) std::printf("%s\n", source_health.c_str());
   const SourceDamage damage = plan.source->damage();
   if (!ex.status.ok()) {
     if (damage.any()) printDamage(damage);

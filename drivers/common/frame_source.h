@@ -1,6 +1,7 @@
 #pragma once
 // FrameSource: the one interface every producer of RGB-D frames implements — dataset replay,
 // synthetic scenes, our recordings, OpenNI2, V4L2. The pipeline's capture stage only sees this.
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -46,6 +47,13 @@ class FrameSource {
   virtual std::size_t frameCount() const { return 0; }
   // What the source skipped so far (see SourceDamage); none for sources that cannot be damaged.
   virtual SourceDamage damage() const { return SourceDamage{}; }
+  // Live sources: what supervision and capture counted (errors, reconnects, time disconnected,
+  // frames missing, unpaired colour/depth, driver-flagged buffers), for run reports: a summary
+  // line, then one line per recorded event. Empty when there is nothing to report (replays).
+  virtual std::string healthReport() const { return ""; }
+  // A flag the caller sets to end the run (SIGINT): a live source that blocks (reconnecting with
+  // backoff) checks it and returns kNoFrame soon after. nullptr = none. Wrappers forward it.
+  virtual void setStopFlag(const std::atomic<bool>* stop) { (void)stop; }
 };
 
 }  // namespace plumb

@@ -38,6 +38,8 @@ class SkipFramesSource : public FrameSource {
     return n > skip_ ? n - std::size_t(skip_) : 0;
   }
   SourceDamage damage() const override { return inner_->damage(); }
+  std::string healthReport() const override { return inner_->healthReport(); }
+  void setStopFlag(const std::atomic<bool>* stop) override { inner_->setStopFlag(stop); }
 
  private:
   std::unique_ptr<FrameSource> inner_;

@@ -13,7 +13,10 @@ bool SourceCapture::prepareNext(int64_t* t_recorded_ns) {
   for (;;) {
     const SourceResult r = source_.next(staging_);
     if (r == SourceResult::kEndOfStream) return false;
-    if (r == SourceResult::kNoFrame) continue;  // a live source's timeout: ask again
+    if (r == SourceResult::kNoFrame) {  // a live source's timeout: ask again, unless told to stop
+      if (stop_ != nullptr && stop_->load(std::memory_order_relaxed)) return false;
+      continue;
+    }
     staged_ = true;
     if (r == SourceResult::kError) {
       error_ = source_.lastError().withContext(source_.describe());

@@ -3,6 +3,7 @@
 // frame is read ahead with next() into a staging image in prepareNext(); take() swaps it into the
 // slot's image (cv::Mat headers only), drop() forgets it. Every source works this way, live or
 // replayed: a TUM folder decodes its next PNG pair ahead exactly as a camera's frame arrives ahead.
+#include <atomic>
 #include <cstdint>
 
 #include "drivers/common/frame_source.h"
@@ -12,7 +13,14 @@ namespace plumb {
 
 class SourceCapture final : public FrameCapture {
  public:
-  explicit SourceCapture(FrameSource& source) : source_(source) {}
+  // `stop` (optional, e.g. set by a SIGINT handler): a live source that has no frame (kNoFrame)
+  // ends the capture once it is set, instead of being asked again forever; the source gets it too
+  // (FrameSource::setStopFlag), so a reconnection in progress gives up waiting.
+  explicit SourceCapture(FrameSource& source, const std::atomic<bool>* stop = nullptr)
+      : source_(source), stop_(stop) {
+    source_.setStopFlag(stop);
+  }
+  ~SourceCapture() override { source_.setStopFlag(nullptr); }
 
   const PinholeCamera& camera() const override { return source_.camera(); }
 
@@ -22,6 +30,7 @@ class SourceCapture final : public FrameCapture {
 
  private:
   FrameSource& source_;
+  const std::atomic<bool>* stop_;
   RgbdImage staging_;
   bool staged_ = false;
   int64_t staged_t_ns_ = 0;

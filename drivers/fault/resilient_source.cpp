@@ -59,13 +59,14 @@ SourceResult ResilientSource::next(RgbdImage& out) {
       stats_.last_error = inner_->describe() + ": no frame for " +
                           std::to_string((clock_.nowNs() - last_frame_ns_) / 1000000) + " ms";
       record(SourceEventKind::kStallTimeout);
-      if (!recover()) return SourceResult::kError;
+      if (!recover()) return stopRequested() ? SourceResult::kNoFrame : SourceResult::kError;
       continue;
     }
     ++stats_.errors;
     stats_.last_error = inner_->lastError().message();
     record(SourceEventKind::kError);
     if (!inner_->isLive() || !recover()) {
+      if (inner_->isLive() && stopRequested()) return SourceResult::kNoFrame;
       error_ = inner_->isLive() ? error_ : inner_->lastError();
       return SourceResult::kError;
     }
@@ -79,6 +80,10 @@ bool ResilientSource::recover() {
   int64_t backoff_ns = options_.initial_backoff_ns;
   for (int attempt = 1; options_.max_reopen_attempts == 0 || attempt <= options_.max_reopen_attempts;
        ++attempt) {
+    if (stopRequested()) {  // the run is ending: stop waiting for the camera
+      stats_.time_disconnected_ns += clock_.nowNs() - failed_at_ns;
+      return false;
+    }
     ++stats_.reopen_attempts;
     const Status st = inner_->reopen();
     if (st.ok()) {
@@ -101,6 +106,26 @@ bool ResilientSource::recover() {
                          std::to_string(options_.max_reopen_attempts) +
                          " reopen attempts; last error: " + stats_.last_error);
   return false;
+}
+
+std::string ResilientSource::healthReport() const {
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "source: errors %llu, stall timeouts %llu, reconnects %llu (%.3f s disconnected, %llu failed "
+                "reopens), frames missing %llu in %llu gaps",
+                static_cast<unsigned long long>(stats_.errors), static_cast<unsigned long long>(stats_.stall_timeouts),
+                static_cast<unsigned long long>(stats_.reconnects), stats_.time_disconnected_ns * 1e-9,
+                static_cast<unsigned long long>(stats_.reopen_failures),
+                static_cast<unsigned long long>(stats_.frames_missing), static_cast<unsigned long long>(stats_.gaps));
+  const std::string inner = inner_->healthReport();
+  std::string text = inner.empty() ? std::string(line) : std::string(line) + "; " + inner;
+  const std::string events = describeEvents();
+  for (std::size_t start = 0; start < events.size();) {
+    const std::size_t end = events.find('\n', start);
+    text += "\n  " + events.substr(start, end - start);
+    start = end == std::string::npos ? events.size() : end + 1;
+  }
+  return text;
 }
 
 std::string ResilientSource::describeEvents() const {

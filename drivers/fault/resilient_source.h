@@ -64,6 +64,16 @@ class ResilientSource : public FrameSource {
   const Status& lastError() const override { return error_; }
   Status reopen() override { return inner_->reopen(); }
   bool isLive() const override { return inner_->isLive(); }
+  // "source: errors N, stall timeouts N, reconnects N (T s disconnected, N failed reopens), frames
+  // missing N in N gaps" and, after "; ", the supervised source's own report; then the events
+  // (describeEvents), each line indented by two spaces.
+  std::string healthReport() const override;
+  // While reconnecting, the flag is checked before every attempt and after every backoff sleep:
+  // once set, next() returns kNoFrame (at most one backoff, 2 s, later).
+  void setStopFlag(const std::atomic<bool>* stop) override {
+    stop_ = stop;
+    inner_->setStopFlag(stop);
+  }
 
   const ResilienceStats& stats() const { return stats_; }
   // One line per event ("t=1.250s error: ..."), for run reports.
@@ -79,6 +89,8 @@ class ResilientSource : public FrameSource {
   SourceClock& clock_;
   ResilienceStats stats_;
   Status error_;
+  const std::atomic<bool>* stop_ = nullptr;
+  bool stopRequested() const { return stop_ != nullptr && stop_->load(std::memory_order_relaxed); }
   bool have_last_sequence_ = false;
   uint64_t last_sequence_ = 0;
   int64_t last_frame_ns_ = 0;

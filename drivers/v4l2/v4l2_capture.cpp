@@ -6,7 +6,6 @@
 
 #include <cerrno>
 #include <cstring>
-#include <ctime>
 
 namespace plumb {
 namespace {
@@ -17,8 +16,26 @@ uint32_t fourcc(V4l2PixelFormat format) {
     case V4l2PixelFormat::kMjpeg: return V4L2_PIX_FMT_MJPEG;
     case V4l2PixelFormat::kGrey: return V4L2_PIX_FMT_GREY;
     case V4l2PixelFormat::kZ16: return V4L2_PIX_FMT_Z16;
+    case V4l2PixelFormat::kY16: return V4L2_PIX_FMT_Y16;
   }
   return 0;
+}
+
+constexpr V4l2PixelFormat kAllFormats[] = {V4l2PixelFormat::kYuyv, V4l2PixelFormat::kMjpeg, V4l2PixelFormat::kGrey,
+                                           V4l2PixelFormat::kZ16, V4l2PixelFormat::kY16};
+
+// The format the driver answered, when plumb can take it in place of the one asked for.
+bool acceptedSubstitute(V4l2PixelFormat asked, uint32_t offered, V4l2PixelFormat* got) {
+  for (V4l2PixelFormat f : kAllFormats) {
+    if (fourcc(f) != offered) continue;
+    const bool depth_pair = (asked == V4l2PixelFormat::kZ16 && f == V4l2PixelFormat::kY16) ||
+                            (asked == V4l2PixelFormat::kY16 && f == V4l2PixelFormat::kZ16);
+    if (f == asked || depth_pair) {
+      *got = f;
+      return true;
+    }
+  }
+  return false;
 }
 
 std::string fourccText(uint32_t code) {
@@ -35,13 +52,17 @@ const char* pixelFormatName(V4l2PixelFormat format) {
     case V4l2PixelFormat::kMjpeg: return "mjpeg";
     case V4l2PixelFormat::kGrey: return "grey";
     case V4l2PixelFormat::kZ16: return "z16";
+    case V4l2PixelFormat::kY16: return "y16";
   }
   return "?";
 }
 
+bool timestampOnMonotonicClock(int64_t timestamp_ns, int64_t now_ns) {
+  return timestamp_ns > 0 && timestamp_ns <= now_ns && now_ns - timestamp_ns <= kMaxBufferAgeNs;
+}
+
 bool parsePixelFormat(const std::string& name, V4l2PixelFormat* format) {
-  for (V4l2PixelFormat f : {V4l2PixelFormat::kYuyv, V4l2PixelFormat::kMjpeg,
-                            V4l2PixelFormat::kGrey, V4l2PixelFormat::kZ16}) {
+  for (V4l2PixelFormat f : kAllFormats) {
     if (name == pixelFormatName(f)) {
       *format = f;
       return true;
@@ -59,6 +80,7 @@ Status V4l2Capture::fail(const char* what, int error_number) const {
 Status V4l2Capture::open(const V4l2CaptureOptions& options) {
   close();
   options_ = options;
+  have_previous_ = false;
   if (options.buffer_count < 2 || options.buffer_count > kMaxBuffers)
     return Status::Error(options.device_path + ": buffer_count must be 2.." +
                          std::to_string(kMaxBuffers));
@@ -79,30 +101,13 @@ Status V4l2Capture::open(const V4l2CaptureOptions& options) {
   }
 
   v4l2_format fmt{};
-  fmt.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-  fmt.fmt.pix.width = static_cast<uint32_t>(options.width);
-  fmt.fmt.pix.height = static_cast<uint32_t>(options.height);
-  fmt.fmt.pix.pixelformat = fourcc(options.format);
-  fmt.fmt.pix.field = V4L2_FIELD_NONE;
-  if (device_.ioctl(fd_, VIDIOC_S_FMT, &fmt) < 0) {
-    const Status st = fail("VIDIOC_S_FMT", errno);
+  const Status format_status = negotiateFormat(&fmt);
+  if (!format_status.ok()) {
     close();
-    return st;
-  }
-  // Drivers adjust what they cannot do instead of failing: check what we actually got.
-  if (fmt.fmt.pix.pixelformat != fourcc(options.format) ||
-      fmt.fmt.pix.width != static_cast<uint32_t>(options.width) ||
-      fmt.fmt.pix.height != static_cast<uint32_t>(options.height)) {
-    const std::string got = fourccText(fmt.fmt.pix.pixelformat) + " " +
-                            std::to_string(fmt.fmt.pix.width) + "x" +
-                            std::to_string(fmt.fmt.pix.height);
-    close();
-    return Status::Error(options.device_path + ": VIDIOC_S_FMT: asked for " +
-                         pixelFormatName(options.format) + " " + std::to_string(options.width) +
-                         "x" + std::to_string(options.height) + ", driver offers " + got);
+    return format_status;
   }
   const std::size_t bytes_per_pixel =
-      options.format == V4l2PixelFormat::kGrey ? 1 : (options.format == V4l2PixelFormat::kMjpeg ? 0 : 2);
+      format_ == V4l2PixelFormat::kGrey ? 1 : (format_ == V4l2PixelFormat::kMjpeg ? 0 : 2);
   stride_ = fmt.fmt.pix.bytesperline ? fmt.fmt.pix.bytesperline : options.width * bytes_per_pixel;
 
   v4l2_streamparm parm{};  // frame rate: best effort, many drivers ignore or round it
@@ -161,6 +166,39 @@ Status V4l2Capture::open(const V4l2CaptureOptions& options) {
   return Status::Ok();
 }
 
+Status V4l2Capture::negotiateFormat(v4l2_format* fmt) {
+  // Depth: Z16 first, then Y16 (same layout). A driver that cannot do a format either substitutes
+  // another one (most) or refuses it with EINVAL (v4l2loopback, whose format its writer sets).
+  const V4l2PixelFormat asked = options_.format;
+  V4l2PixelFormat candidates[2] = {asked, asked};
+  int count = 1;
+  if (asked == V4l2PixelFormat::kZ16) candidates[count++] = V4l2PixelFormat::kY16;
+  Status first_problem;
+  for (int i = 0; i < count; ++i) {
+    *fmt = v4l2_format{};
+    fmt->type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+    fmt->fmt.pix.width = static_cast<uint32_t>(options_.width);
+    fmt->fmt.pix.height = static_cast<uint32_t>(options_.height);
+    fmt->fmt.pix.pixelformat = fourcc(candidates[i]);
+    fmt->fmt.pix.field = V4L2_FIELD_NONE;
+    Status problem;
+    if (device_.ioctl(fd_, VIDIOC_S_FMT, fmt) < 0) {
+      problem = fail("VIDIOC_S_FMT", errno);
+    } else if (acceptedSubstitute(asked, fmt->fmt.pix.pixelformat, &format_) &&
+               fmt->fmt.pix.width == static_cast<uint32_t>(options_.width) &&
+               fmt->fmt.pix.height == static_cast<uint32_t>(options_.height)) {
+      return Status::Ok();
+    } else {  // drivers adjust what they cannot do instead of failing: say what we got
+      problem = Status::Error(options_.device_path + ": VIDIOC_S_FMT: asked for " + pixelFormatName(asked) + " " +
+                              std::to_string(options_.width) + "x" + std::to_string(options_.height) +
+                              ", driver offers " + fourccText(fmt->fmt.pix.pixelformat) + " " +
+                              std::to_string(fmt->fmt.pix.width) + "x" + std::to_string(fmt->fmt.pix.height));
+    }
+    if (i == 0) first_problem = problem;
+  }
+  return first_problem;
+}
+
 Status V4l2Capture::queueBuffer(uint32_t index) {
   v4l2_buffer buf{};
   buf.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
@@ -181,35 +219,56 @@ SourceResult V4l2Capture::dequeue(V4l2FrameView* view, Status* error) {
   }
   const int ready = device_.poll(fd_, options_.poll_timeout_ms);
   if (ready == 0) return SourceResult::kNoFrame;
-  if (ready < 0) {
-    *error = fail("poll", errno);
-    return SourceResult::kError;
-  }
+  const int poll_errno = ready < 0 ? errno : 0;
+  // Even when poll reports an error, DQBUF is asked: its errno is the driver's reason (ENODEV for
+  // an unplugged node, EIO after a streaming error), and a buffer may still be waiting.
   v4l2_buffer buf{};
   buf.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
   buf.memory = V4L2_MEMORY_MMAP;
   if (device_.ioctl(fd_, VIDIOC_DQBUF, &buf) < 0) {
-    if (errno == EAGAIN) return SourceResult::kNoFrame;
-    *error = fail("VIDIOC_DQBUF", errno);
+    if (errno == EAGAIN && ready > 0) return SourceResult::kNoFrame;
+    *error = errno == EAGAIN ? fail("poll", poll_errno) : fail("VIDIOC_DQBUF", errno);
     return SourceResult::kError;
   }
   if (buf.index >= buffers_.size() || buf.bytesused > buffers_[buf.index].length) {
     *error = Status::Error(options_.device_path + ": VIDIOC_DQBUF returned an invalid buffer");
     return SourceResult::kError;
   }
+  if (buf.flags & V4L2_BUF_FLAG_ERROR) {
+    // The driver says the content is damaged (a USB packet lost, an injected fault): it is never
+    // delivered; its sequence number stays unused, so the frame counts as missing downstream.
+    ++counters_.error_buffers;
+    const Status st = queueBuffer(buf.index);
+    if (!st.ok()) {
+      *error = st;
+      return SourceResult::kError;
+    }
+    return SourceResult::kNoFrame;
+  }
   dequeued_index_ = static_cast<int>(buf.index);
   view->data = static_cast<const uint8_t*>(buffers_[buf.index].address);
   view->bytes_used = buf.bytesused;
   view->stride = stride_;
-  if ((buf.flags & V4L2_BUF_FLAG_TIMESTAMP_MASK) == V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC) {
-    view->timestamp_ns = static_cast<int64_t>(buf.timestamp.tv_sec) * 1000000000 +
-                         static_cast<int64_t>(buf.timestamp.tv_usec) * 1000;
-  } else {  // unknown clock: the dequeue time is the best host-monotonic stamp we have
-    timespec now{};
-    clock_gettime(CLOCK_MONOTONIC, &now);
-    view->timestamp_ns = static_cast<int64_t>(now.tv_sec) * 1000000000 + now.tv_nsec;
+  const int64_t now_ns = device_.monotonicNowNs();
+  const int64_t stamp_ns = static_cast<int64_t>(buf.timestamp.tv_sec) * 1000000000 +
+                           static_cast<int64_t>(buf.timestamp.tv_usec) * 1000;
+  if (timestampOnMonotonicClock(stamp_ns, now_ns)) {
+    view->timestamp_ns = stamp_ns;
+  } else {  // off the clock: the dequeue time is the best host-monotonic stamp we have
+    view->timestamp_ns = now_ns;
+    ++counters_.dequeue_time_stamps;
   }
   view->sequence = buf.sequence;
+  ++counters_.buffers;
+  const uint32_t step = buf.sequence - previous_sequence_;
+  const int64_t elapsed_ns = view->timestamp_ns - previous_stamp_ns_;
+  if (have_previous_ && step >= 1 && step <= 64 && elapsed_ns > 0) {
+    const double period_ns = double(elapsed_ns) / step;
+    observed_period_ns_ = observed_period_ns_ > 0 ? 0.9 * observed_period_ns_ + 0.1 * period_ns : period_ns;
+  }
+  have_previous_ = true;
+  previous_stamp_ns_ = view->timestamp_ns;
+  previous_sequence_ = buf.sequence;
   return SourceResult::kFrame;
 }
 

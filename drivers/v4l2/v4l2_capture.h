@@ -6,6 +6,8 @@
 //   close: VIDIOC_STREAMOFF -> munmap -> close.
 // Every failure names the device and the ioctl, e.g. "/dev/video2: VIDIOC_DQBUF failed: No such
 // device (device disconnected)".
+#include <linux/videodev2.h>
+
 #include <cstdint>
 #include <string>
 
@@ -16,9 +18,11 @@
 
 namespace plumb {
 
-enum class V4l2PixelFormat { kYuyv, kMjpeg, kGrey, kZ16 };
+// kY16 ('Y16 ', 16-bit little-endian grey) is accepted in place of kZ16 on a depth node: same
+// layout, and the format v4l2loopback and some depth cameras announce for depth.
+enum class V4l2PixelFormat { kYuyv, kMjpeg, kGrey, kZ16, kY16 };
 
-// "yuyv", "mjpeg", "grey", "z16".
+// "yuyv", "mjpeg", "grey", "z16", "y16".
 const char* pixelFormatName(V4l2PixelFormat format);
 bool parsePixelFormat(const std::string& name, V4l2PixelFormat* format);
 
@@ -36,9 +40,26 @@ struct V4l2FrameView {
   const uint8_t* data = nullptr;
   std::size_t bytes_used = 0;
   std::size_t stride = 0;     // bytes per line
-  int64_t timestamp_ns = 0;   // driver timestamp (CLOCK_MONOTONIC when the driver says so)
+  // The buffer's kernel timestamp when it is on CLOCK_MONOTONIC (see timestampOnMonotonicClock),
+  // else the dequeue time.
+  int64_t timestamp_ns = 0;
   uint32_t sequence = 0;      // driver frame counter (gaps = frames the driver dropped)
 };
+
+// What a node's driver did, counted over the capture's life (reopens included).
+struct V4l2CaptureCounters {
+  uint64_t buffers = 0;              // buffers delivered to the caller
+  uint64_t error_buffers = 0;        // flagged V4L2_BUF_FLAG_ERROR: given back unread
+  uint64_t dequeue_time_stamps = 0;  // delivered with the dequeue time (their own was off the clock)
+};
+
+// A buffer timestamp is used as the frame's time only when it can be on CLOCK_MONOTONIC: not in
+// the future and at most kMaxBufferAgeNs old at dequeue. The V4L2 flag alone is not enough: vivid's
+// "Wrap Timestamp" flags MONOTONIC stamps that are far off that clock, and v4l2loopback stamps with
+// ktime_get_ts64 (monotonic) but flags the clock unknown. Two nodes of one camera stamped this way
+// can be paired by their kernel times.
+constexpr int64_t kMaxBufferAgeNs = 2'000'000'000;
+bool timestampOnMonotonicClock(int64_t timestamp_ns, int64_t now_ns);
 
 class V4l2Capture {
  public:
@@ -56,6 +77,13 @@ class V4l2Capture {
   void close();      // best effort, never fails: also used after the device vanished
   bool isOpen() const { return fd_ >= 0; }
   const V4l2CaptureOptions& options() const { return options_; }
+  // The format the driver streams (options().format, or kY16 standing in for kZ16).
+  V4l2PixelFormat format() const { return format_; }
+  const V4l2CaptureCounters& counters() const { return counters_; }
+  // The node's frame period as its buffers show it (stamp difference over sequence difference, a
+  // running mean over ~10 buffers; kept across reopens), 0 until two buffers were seen. Cameras
+  // may run slower than the rate asked with VIDIOC_S_PARM, which drivers are free to ignore.
+  double observedPeriodNs() const { return observed_period_ns_; }
 
  private:
   struct MappedBuffer {
@@ -63,12 +91,20 @@ class V4l2Capture {
     std::size_t length = 0;
   };
   Status fail(const char* what, int error_number) const;
+  // VIDIOC_S_FMT with options_.format (for Z16 also Y16); sets format_ and fills *fmt.
+  Status negotiateFormat(v4l2_format* fmt);
   Status queueBuffer(uint32_t index);
 
   V4l2Device& device_;
   V4l2CaptureOptions options_;
   int fd_ = -1;
   bool streaming_ = false;
+  V4l2PixelFormat format_ = V4l2PixelFormat::kYuyv;
+  V4l2CaptureCounters counters_;
+  bool have_previous_ = false;  // a buffer was delivered since open()
+  int64_t previous_stamp_ns_ = 0;
+  uint32_t previous_sequence_ = 0;
+  double observed_period_ns_ = 0;
   std::size_t stride_ = 0;
   FixedVector<MappedBuffer, kMaxBuffers> buffers_;
   int dequeued_index_ = -1;  // buffer held by the caller, -1 = none

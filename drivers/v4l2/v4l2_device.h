@@ -6,6 +6,7 @@
 #include <sys/types.h>
 
 #include <cstddef>
+#include <cstdint>
 
 namespace plumb {
 
@@ -17,8 +18,11 @@ class V4l2Device {
   virtual int ioctl(int fd, unsigned long request, void* arg) = 0;
   virtual void* mmap(std::size_t length, int fd, off_t offset) = 0;  // PROT_READ|WRITE, SHARED
   virtual int munmap(void* address, std::size_t length) = 0;
-  // Waits until `fd` has a buffer ready: >0 ready, 0 timeout, -1 error.
+  // Waits until `fd` has a buffer ready: >0 ready, 0 timeout, -1 error (POLLERR/POLLHUP: errno
+  // ENODEV after a hang-up, EIO otherwise; the caller's DQBUF then tells the driver's reason).
   virtual int poll(int fd, int timeout_ms) = 0;
+  // CLOCK_MONOTONIC now, in ns: checks that a buffer's timestamp is on that clock (tests: fake).
+  virtual int64_t monotonicNowNs() = 0;
 };
 
 // The real kernel interface (::open, ::ioctl retried on EINTR, ::mmap, ::poll).

@@ -15,8 +15,9 @@ Status V4l2Source::open(const V4l2SourceOptions& options, const PinholeCamera& c
                         V4l2Device& device, std::unique_ptr<V4l2Source>* out) {
   const std::string problem = camera.validate();
   if (!problem.empty()) return Status::Error("v4l2:" + options.colour_device + ": camera invalid: " + problem);
-  if (options.colour_format == V4l2PixelFormat::kZ16)
-    return Status::Error("v4l2:" + options.colour_device + ": z16 is a depth format, not colour");
+  if (options.colour_format == V4l2PixelFormat::kZ16 || options.colour_format == V4l2PixelFormat::kY16)
+    return Status::Error("v4l2:" + options.colour_device + ": " + pixelFormatName(options.colour_format) +
+                         " is a depth format, not colour");
   std::unique_ptr<V4l2Source> source(new V4l2Source(device));
   source->options_ = options;
   source->camera_ = camera;
@@ -50,6 +51,28 @@ Status V4l2Source::openNodes() {
     }
   }
   return Status::Ok();
+}
+
+int64_t V4l2Source::pairWindowNs() const {
+  // Half the frame period the streams keep (16 ms at 30 Hz): a closer pair is the same instant,
+  // and no frame of the other stream can be closer; never below the configured minimum.
+  double period_ns = colour_.observedPeriodNs();
+  if (depth_.observedPeriodNs() > 0 && (period_ns <= 0 || depth_.observedPeriodNs() < period_ns))
+    period_ns = depth_.observedPeriodNs();
+  return std::max<int64_t>(options_.max_pair_dt_ns, int64_t(period_ns / 2));
+}
+
+std::string V4l2Source::healthReport() const {
+  const V4l2CaptureCounters& c = colour_.counters();
+  const V4l2CaptureCounters& d = depth_.counters();
+  std::string text = "v4l2: pairs " + std::to_string(stats_.pairs) + ", unpaired colour " +
+                     std::to_string(stats_.unpaired_colour) + ", unpaired depth " +
+                     std::to_string(stats_.unpaired_depth) + ", undecodable " + std::to_string(stats_.undecodable) +
+                     ", error buffers " + std::to_string(c.error_buffers + d.error_buffers) +
+                     ", dequeue-time stamps " + std::to_string(c.dequeue_time_stamps + d.dequeue_time_stamps);
+  if (!options_.depth_device.empty() && depth_.isOpen())
+    text += std::string(", depth format ") + pixelFormatName(depth_.format());
+  return text;
 }
 
 std::string V4l2Source::describe() const {
@@ -95,7 +118,7 @@ SourceResult V4l2Source::next(RgbdImage& out) {
       holding_depth_ = true;
     }
     const int64_t dt_ns = paired_mode ? colour_view_.timestamp_ns - depth_view_.timestamp_ns : 0;
-    if (std::llabs(dt_ns) <= options_.max_pair_dt_ns) {
+    if (std::llabs(dt_ns) <= pairWindowNs()) {
       const bool converted = convert(out);
       holding_colour_ = holding_depth_ = false;
       Status st = colour_.requeue();
@@ -139,6 +162,7 @@ bool V4l2Source::convert(RgbdImage& out) {
       if (!mjpegToBgr(c.data, c.bytes_used, w, h, out.bgr)) return false;
       break;
     case V4l2PixelFormat::kZ16:
+    case V4l2PixelFormat::kY16:
       return false;
   }
   const int dw = camera_.depthWidth(), dh = camera_.depthHeight();
@@ -154,11 +178,23 @@ bool V4l2Source::convert(RgbdImage& out) {
   // Sequence: driver counter differences within a session; across a reopen, the time gap.
   uint64_t step = 1;
   if (have_last_ && reopened_) {
-    const double period_ns = 1e9 / options_.fps;
+    // The frame period the camera really kept (a camera may run slower than asked), else the
+    // nominal one.
+    const double period_ns = colour_.observedPeriodNs() > 0 ? colour_.observedPeriodNs() : 1e9 / options_.fps;
     step = static_cast<uint64_t>(
         std::max(1.0, std::round((c.timestamp_ns - last_timestamp_ns_) / period_ns)));
-  } else if (have_last_ && c.sequence > last_driver_sequence_) {
-    step = c.sequence - last_driver_sequence_;
+  } else if (have_last_) {
+    // Modulo 2^32: the driver's counter wraps (vivid's "Wrap Sequence Number" tests exactly that).
+    // A step of 0 or one that looks backwards (over half the range) is a restarted counter.
+    const uint32_t driver_step = c.sequence - last_driver_sequence_;
+    if (driver_step > 0 && driver_step < 0x80000000u) step = driver_step;
+    // A camera cannot have made more frames than fit in the time between the two stamps (at up to
+    // twice the rate it kept): a larger jump is a counter that restarted (v4l2loopback numbers the
+    // first frame after a reader's VIDIOC_REQBUFS 0), not lost frames.
+    const int64_t elapsed_ns = c.timestamp_ns - last_timestamp_ns_;
+    const double period_ns = colour_.observedPeriodNs();
+    if (period_ns > 0 && elapsed_ns > 0)
+      step = std::min<uint64_t>(step, std::max<uint64_t>(1, uint64_t(2.0 * elapsed_ns / period_ns)));
   }
   out.sequence = have_last_ ? last_sequence_ + step : 0;
   have_last_ = true;

@@ -3,9 +3,11 @@
 // (Z16, as RealSense-class cameras expose depth over UVC) by timestamp. Without a depth node the
 // depth image is all zeros ("no reading") and the source says so in describe().
 //
-// Pairing: hold the newest buffer of each node; when their timestamps differ by more than
-// max_pair_dt_ns, give back the older one and take the next from that node. Unpaired frames are
-// counted. V4L2 reports no intrinsics, so the camera comes from a camera file or preset.
+// Pairing: by the buffers' kernel timestamps (CLOCK_MONOTONIC, checked per buffer: see
+// timestampOnMonotonicClock). Hold one buffer of each node; when their timestamps differ by more
+// than half the frame period the nodes keep (at least max_pair_dt_ns), give back the older one and
+// take the next from that node. Unpaired frames are counted. Depth may come as Z16 or Y16 (same layout). V4L2 reports no intrinsics, so the
+// camera comes from a camera file or preset.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -22,7 +24,8 @@ struct V4l2SourceOptions {
   int fps = 30;
   int buffer_count = 4;
   int poll_timeout_ms = 100;
-  // Half a frame period at 30 Hz: a closer pair is the same instant, a farther one is not.
+  // Pairing window: half the frame period the streams keep (observed), at least this: 16 ms is
+  // half a frame at 30 Hz. A closer pair is the same instant, a farther one is not.
   int64_t max_pair_dt_ns = 16'000'000;
   // Z16 units per metre: 1000 for millimetre depth (RealSense default depth unit).
   double depth_factor = 1000.0;
@@ -47,6 +50,9 @@ class V4l2Source : public FrameSource {
   const Status& lastError() const override { return error_; }
   Status reopen() override;
   bool isLive() const override { return true; }
+  // "v4l2: pairs N, unpaired colour N, unpaired depth N, undecodable N, error buffers N,
+  // dequeue-time stamps N[, depth format z16|y16]".
+  std::string healthReport() const override;
 
   const V4l2PairingStats& pairingStats() const { return stats_; }
 
@@ -55,6 +61,7 @@ class V4l2Source : public FrameSource {
   Status openNodes();
   SourceResult fail(const Status& error);
   bool convert(RgbdImage& out);
+  int64_t pairWindowNs() const;
 
   V4l2SourceOptions options_;
   PinholeCamera camera_;

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <ctime>
 
 #include "drivers/v4l2/v4l2_device.h"
 
@@ -34,10 +35,17 @@ class SystemV4l2Device : public V4l2Device {
       r = ::poll(&p, 1, timeout_ms);
     } while (r == -1 && errno == EINTR);
     if (r > 0 && (p.revents & (POLLERR | POLLHUP | POLLNVAL)) && !(p.revents & POLLIN)) {
-      errno = ENODEV;  // the kernel signals an unplugged device this way
+      // An unregistered (unplugged) node reports POLLERR|POLLHUP; a streaming error in the driver
+      // (vb2_queue_error) only POLLERR. Either way DQBUF then says what happened.
+      errno = (p.revents & (POLLHUP | POLLNVAL)) ? ENODEV : EIO;
       return -1;
     }
     return r;
+  }
+  int64_t monotonicNowNs() override {
+    timespec now{};
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    return static_cast<int64_t>(now.tv_sec) * 1000000000 + now.tv_nsec;
   }
 };
 

@@ -22,7 +22,10 @@ bool CaptureStage::peekNext(int64_t* t_recorded_ns) {
     stopped_ = true;
     return ended();
   }
-  return capture_.prepareNext(t_recorded_ns) || ended();
+  if (capture_.prepareNext(t_recorded_ns)) return true;
+  // A live source without frames ends the capture when the stop flag is set: that is a stop too.
+  if (stop_ != nullptr && stop_->load(std::memory_order_relaxed)) stopped_ = true;
+  return ended();
 }
 
 bool CaptureStage::stopRequested() {

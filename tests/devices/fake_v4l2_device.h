@@ -7,6 +7,7 @@
 #include <linux/videodev2.h>
 #include <sys/mman.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <deque>
@@ -24,6 +25,7 @@ struct FakeV4l2Node {
   uint32_t width = 4, height = 2;
   uint32_t bytes_per_line = 8;
   uint32_t offered_width = 0;  // non-zero: S_FMT answers with this width instead (driver adjusts)
+  bool refuses_other_formats = false;  // S_FMT of another fourcc fails with EINVAL (v4l2loopback)
   int64_t first_timestamp_ns = 1'000'000'000;
   int64_t period_ns = 33'333'333;
   // Fills frame number k (k counts every frame the "sensor" produced, including unplugged time).
@@ -33,6 +35,11 @@ struct FakeV4l2Node {
   int failing_errno = EINVAL;
   int unplug_after_dequeues = -1;     // DQBUF number n (0-based) fails with ENODEV; -1 never
   bool unplugged = false;             // open() fails with ENODEV while set
+  std::vector<uint64_t> error_frames;  // frames returned with V4L2_BUF_FLAG_ERROR
+  int queue_error_after_dequeues = -1;  // then poll -> POLLERR (EIO) and DQBUF -> EIO until STREAMOFF
+  bool queue_error = false;
+  uint32_t timestamp_flags = V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC;
+  uint32_t first_sequence = 0;        // the driver's counter for frame 0 (wrap tests)
   // State.
   std::vector<std::vector<uint8_t>> buffers;
   std::deque<uint32_t> queued;
@@ -48,6 +55,12 @@ class FakeV4l2Device : public V4l2Device {
   bool logging = true;  // off for allocation tests (the log itself allocates)
   int live_mappings = 0;
   int open_fds = 0;
+  // CLOCK_MONOTONIC as the fake reports it: 0 = 1 ms after the newest timestamp handed out (frames
+  // are then always fresh); tests set it to age frames or to put the clock elsewhere.
+  int64_t now_ns = 0;
+  int64_t newest_timestamp_ns = 0;
+
+  int64_t monotonicNowNs() override { return now_ns != 0 ? now_ns : newest_timestamp_ns + 1'000'000; }
 
   int open(const char* path, int) override {
     note(std::string("open ") + path);
@@ -85,6 +98,8 @@ class FakeV4l2Device : public V4l2Device {
     note("poll");
     FakeV4l2Node* n = node(fd);
     if (!n) return fail(EBADF);
+    armQueueError(*n);
+    if (n->queue_error) return fail(EIO);  // what the system device reports for POLLERR alone
     return n->queued.empty() ? 0 : 1;
   }
 
@@ -102,6 +117,7 @@ class FakeV4l2Device : public V4l2Device {
       }
       case VIDIOC_S_FMT: {
         auto* fmt = static_cast<v4l2_format*>(arg);
+        if (n->refuses_other_formats && fmt->fmt.pix.pixelformat != n->fourcc) return fail(EINVAL);
         fmt->fmt.pix.pixelformat = n->fourcc;
         fmt->fmt.pix.width = n->offered_width ? n->offered_width : n->width;
         fmt->fmt.pix.height = n->height;
@@ -129,7 +145,11 @@ class FakeV4l2Device : public V4l2Device {
         return 0;
       }
       case VIDIOC_STREAMON: n->streaming = true; return 0;
-      case VIDIOC_STREAMOFF: n->streaming = false; n->queued.clear(); return 0;
+      case VIDIOC_STREAMOFF:
+        n->streaming = false;
+        n->queue_error = false;
+        n->queued.clear();
+        return 0;
       case VIDIOC_DQBUF: {
         if (n->unplug_after_dequeues >= 0 && n->dequeues >= n->unplug_after_dequeues) {
           n->unplugged = true;
@@ -137,6 +157,8 @@ class FakeV4l2Device : public V4l2Device {
           return fail(ENODEV);
         }
         if (n->unplugged) return fail(ENODEV);
+        armQueueError(*n);
+        if (n->queue_error) return fail(EIO);
         if (!n->streaming || n->queued.empty()) return fail(EAGAIN);
         auto* buf = static_cast<v4l2_buffer*>(arg);
         buf->index = n->queued.front();
@@ -145,9 +167,11 @@ class FakeV4l2Device : public V4l2Device {
         uint32_t used = n->bytes_per_line * n->height;
         if (n->fill) n->fill(k, n->buffers[buf->index].data(), n->buffers[buf->index].size(), &used);
         buf->bytesused = used;
-        buf->sequence = static_cast<uint32_t>(k);
-        buf->flags = V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC;
+        buf->sequence = static_cast<uint32_t>(n->first_sequence + k);
+        buf->flags = n->timestamp_flags;
+        for (uint64_t e : n->error_frames) buf->flags |= e == k ? V4L2_BUF_FLAG_ERROR : 0;
         const int64_t t = n->first_timestamp_ns + static_cast<int64_t>(k) * n->period_ns;
+        newest_timestamp_ns = std::max(newest_timestamp_ns, t);
         buf->timestamp.tv_sec = t / 1000000000;
         buf->timestamp.tv_usec = (t % 1000000000) / 1000;
         ++n->dequeues;
@@ -173,6 +197,12 @@ class FakeV4l2Device : public V4l2Device {
 
  private:
   static constexpr std::size_t kPage = 4096;
+  static void armQueueError(FakeV4l2Node& n) {
+    if (n.queue_error_after_dequeues >= 0 && n.dequeues >= n.queue_error_after_dequeues) {
+      n.queue_error = true;
+      n.queue_error_after_dequeues = -1;
+    }
+  }
   static int fail(int e) {
     errno = e;
     return -1;

@@ -3,6 +3,7 @@
 // every reconnection.
 #include <gtest/gtest.h>
 
+#include "drivers/common/source_capture.h"
 #include "drivers/fault/fault_injecting_source.h"
 #include "drivers/fault/resilient_source.h"
 #include "tests/devices/device_test_util.h"
@@ -138,6 +139,58 @@ TEST(FaultSupervision, ReplaysAreNotReopened) {
   EXPECT_EQ(supervised.next(out), SourceResult::kError);
   EXPECT_EQ(supervised.lastError().message(), "replay.plumbrec: read failed");
   EXPECT_EQ(supervised.stats().reopen_attempts, 0u);
+}
+
+}  // namespace
+}  // namespace plumb
+
+// SIGINT while the camera is gone: the supervisor stops waiting for it, and the capture ends
+// instead of asking a silent source again forever (found on the virtual-machine bench, where a
+// stopped run sat out 30 reopen attempts, ~50 s).
+namespace plumb {
+namespace {
+
+// Frames the capture step delivers until it ends.
+int framesUntilTheCaptureEnds(SourceCapture& capture) {
+  int64_t t_ns = 0;
+  int frames = 0;
+  while (capture.prepareNext(&t_ns)) {
+    RgbdImage out;
+    if (!capture.take(out).ok()) break;
+    ++frames;
+  }
+  return frames;
+}
+
+TEST(FaultSupervision, AStopRequestEndsAReconnectionInProgress) {
+  std::atomic<bool> stop{false};
+  class StoppingClock : public VirtualClock {
+   public:
+    explicit StoppingClock(std::atomic<bool>& stop) : stop_(stop) {}
+    void sleepForNs(int64_t ns) override {
+      VirtualClock::sleepForNs(ns);
+      if (sleeps_ns.size() == 2) stop_.store(true);  // the operator presses Ctrl-C
+    }
+    std::atomic<bool>& stop_;
+  } clock(stop);
+  auto inner = std::make_unique<test::VectorSource>(test::makeNoiseFrames(9, 8, 6, kFrames), test::smallCamera(8, 6));
+  auto faulty = std::make_unique<FaultInjectingSource>(
+      std::move(inner), std::vector<FaultEvent>{{3, FaultKind::kDisconnect, 4, /*failed reopens*/ 1000}});
+  ResilientSource supervised(std::move(faulty), {}, clock);
+  SourceCapture capture(supervised, &stop);
+  EXPECT_EQ(framesUntilTheCaptureEnds(capture), 3);
+  EXPECT_EQ(clock.sleeps_ns.size(), 2u) << "no reopen attempt after the stop";
+  EXPECT_EQ(supervised.stats().reopen_attempts, 2u);
+  EXPECT_EQ(supervised.stats().reconnects, 0u);
+}
+
+TEST(FaultSupervision, WithoutAStopASilentLiveSourceIsAskedAgain) {
+  // The other side of the rule: kNoFrame alone never ends a capture.
+  std::atomic<bool> stop{false};
+  auto inner = std::make_unique<test::VectorSource>(test::makeNoiseFrames(9, 8, 6, 4), test::smallCamera(8, 6));
+  FaultInjectingSource stalling(std::move(inner), {{1, FaultKind::kStall, 5}});
+  SourceCapture capture(stalling, &stop);
+  EXPECT_EQ(framesUntilTheCaptureEnds(capture), 4);
 }
 
 }  // namespace
