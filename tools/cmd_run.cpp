@@ -24,6 +24,7 @@
 #include "tools/map_files.h"
 #include "tools/run_flags.h"
 #include "tools/run_outputs.h"
+#include "tools/serve_flag.h"
 
 namespace plumb::tools {
 namespace {
@@ -65,6 +66,9 @@ void printRunUsage() {
       "  --count-allocations  print heap allocations per frame after a 30-frame warm-up\n"
       "  --mavlink ENDPOINT   MAVLink v2 ODOMETRY + HEARTBEAT to an autopilot, as each pose is tracked:\n"
       "                       udp:HOST:PORT or serial:DEVICE:BAUD (frames: docs/MAVLINK.md)\n"
+      "  --serve PORT|HOST:PORT watch the run live: Foxglove WebSocket server and a page at http://HOST:PORT/\n"
+      "                       (PORT alone: this machine only; HOST:PORT binds HOST, anyone who reaches it can\n"
+      "                       watch; docs/VIEWER.md). Read-only: the outputs are the same without it\n"
       "Outputs appear only when complete (written aside, renamed into place); an output that is an\n"
       "input is refused before any work. SIGINT/SIGTERM stop the run cleanly: every pose computed so\n"
       "far is written, the statistics say so, and the exit code is 3.\n"
@@ -107,7 +111,7 @@ int runRun(int argc, char** argv) {
   Args args(argc, argv,
             withScheduleFlags({"dataset", "camera", "out", "line-samples", "covariance", "stats", "max-frames",
                                "gt", "output-delay", "rss-every", "mavlink", "report-every", "out-optimized",
-                               "skip-frames", "save-map", "load-map"},
+                               "skip-frames", "save-map", "load-map", "serve"},
                               scheduleValueFlags()),
             withScheduleFlags({"no-lines", "synth-noise", "progress", "trace", "count-allocations", "discard-trajectory",
                                "no-loops"},
@@ -234,8 +238,12 @@ int runRun(int argc, char** argv) {
   output_options.mavlink.endpoint = args.get("mavlink");
 
   RunOutputs outputs(output_options);
+  RunServe serve;
+  st = serve.start(args.get("serve"), outputs, runtime::runModeName(run_options.schedule.mode), spec);
+  if (!st.ok()) return fail(st.message());
   RunRecord record;
-  st = runToOutputs(*source, system_options, run_options, outputs, &record);
+  st = runToOutputs(*source, system_options, run_options, outputs, &record, serve.sink());
+  serve.stop();
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
   // The map is written whatever ended the run (a stop, a read error): like the trajectory, it holds

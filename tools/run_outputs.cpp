@@ -183,13 +183,13 @@ Status RunOutputs::onRetiredKeyframe(const RetiredKeyframe& kf) {
 }
 
 Status runToOutputs(FrameSource& source, const SystemOptions& system_options, const OdometryRunOptions& run_options,
-                    RunOutputs& outputs, RunRecord* record) {
+                    RunOutputs& outputs, RunRecord* record, OdometrySink* sink) {
   std::unique_ptr<OdometrySystem> system;
   PLUMB_RETURN_IF_ERROR(OdometrySystem::create(source.camera(), system_options, &system));
   PLUMB_RETURN_IF_ERROR(validate(run_options));
   PLUMB_RETURN_IF_ERROR(outputs.open());
   SourceCapture capture(source);
-  Status status = runOdometry(capture, *system, outputs, run_options, &record->run);
+  Status status = runOdometry(capture, *system, sink != nullptr ? *sink : outputs, run_options, &record->run);
   const Status closed = outputs.close();
   if (status.ok()) status = closed;
   const Status optimized = outputs.writeOptimized(record->run.loop);

@@ -90,7 +90,9 @@ struct RunRecord {
 
 // Builds the system (options validated there), runs it over `source` through the one runner into
 // `outputs` (opened first, closed after, also when the run failed: what was computed is kept).
+// `sink`: what the runner calls when not `outputs` itself, i.e. a decorator that forwards to
+// `outputs` (the viewer's, viewer/viewer_sink.h); nullptr: `outputs`.
 Status runToOutputs(FrameSource& source, const SystemOptions& system_options, const OdometryRunOptions& run_options,
-                    RunOutputs& outputs, RunRecord* record);
+                    RunOutputs& outputs, RunRecord* record, OdometrySink* sink = nullptr);
 
 }  // namespace plumb::tools
