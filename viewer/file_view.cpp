@@ -54,7 +54,7 @@ void trajectoryStrips(const std::vector<StampedPose>& poses, const Eigen::Isomet
   const std::size_t step = valid > kMaxTrajectoryPoints ? (valid + kMaxTrajectoryPoints - 1) / kMaxTrajectoryPoints : 1;
   LinePrimitive strip;
   strip.color = color;
-  strip.thickness_px = 2.5;
+  strip.thickness_px = 4;
   auto flush = [&] {
     if (strip.points.size() >= 2) {
       *drawn += strip.points.size();

@@ -73,7 +73,7 @@ struct FoxgloveServer::Impl {
   void scheduleTick();
   void schedulePing();
   void onOpen(Handle h);
-  void onClose(Handle h) { clients.erase(h); }
+  void onClose(Handle h);
   void onMessage(Handle h, WsServer::message_ptr message);
   void onHttp(Handle h);
   bool onValidate(Handle h);
@@ -147,6 +147,17 @@ bool FoxgloveServer::Impl::onValidate(Handle h) {
   con->set_status(websocketpp::http::status_code::bad_request);
   con->set_body(std::string("plumb speaks the Foxglove WebSocket protocol: request subprotocol ") + kSubprotocol + "\n");
   return false;
+}
+
+void FoxgloveServer::Impl::onClose(Handle h) {
+  // websocketpp itself closes a client whose message exceeds max_client_message_bytes (1009): a
+  // client still in the table was not closed by us, so count it here.
+  websocketpp::lib::error_code ec;
+  WsServer::connection_ptr con = server.get_con_from_hdl(h, ec);
+  if (clients.count(h) && !ec && con && con->get_local_close_code() == websocketpp::close::status::message_too_big) {
+    ++stats.clients_closed_malformed;
+  }
+  clients.erase(h);
 }
 
 void FoxgloveServer::Impl::onOpen(Handle h) {

@@ -43,7 +43,9 @@ struct FoxgloveServerOptions {
   std::string name = "plumb";      // serverInfo.name
   int tick_hz = 30;                // how often the tick callback runs
   std::size_t max_client_message_bytes = 64 * 1024;  // larger: close code 1009
-  std::size_t max_queued_bytes = 8 * 1024 * 1024;    // per client; beyond it messages are dropped
+  // Per client, beyond what the kernel's socket buffer holds: more and its messages are dropped
+  // (a viewer that far behind is seconds late; newer messages replace what it missed).
+  std::size_t max_queued_bytes = 1024 * 1024;
   int ping_interval_ms = 5000;  // a client that does not answer a ping within this is closed
   int thread_nice = 10;         // the server thread's nice value (0: unchanged)
 };

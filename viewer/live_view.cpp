@@ -162,13 +162,13 @@ void LiveView::publishTrajectory() {
   trajectory_dirty_ = false;
   trajectory_sent_s_ = nowS();
   LineEntity output{"output", {}};
-  appendStrips(output_strips_, kOutputColor, 2.5, kMaxTrajectoryPoints, &output.lines);
+  appendStrips(output_strips_, kOutputColor, 4, kMaxTrajectoryPoints, &output.lines);
   LineEntity tracked{"tracked", {}};
   std::vector<std::vector<Eigen::Vector3f>> tail(1);
   // The tail starts at the newest output pose, so the two lines join.
   if (!output_strips_.back().empty()) tail[0].push_back(output_strips_.back().back());
   for (const TrackPoint& p : tracked_tail_) tail[0].push_back(p.position);
-  appendStrips(tail, kTrackedColor, 2.5, kMaxTrajectoryPoints, &tracked.lines);
+  appendStrips(tail, kTrackedColor, 4, kMaxTrajectoryPoints, &tracked.lines);
   server_.publish(kTrajectory, toNs(last_timestamp_s_), sceneUpdateJson(last_timestamp_s_, {output, tracked}));
 }
 

@@ -5,12 +5,13 @@ export const SUBPROTOCOL = 'foxglove.websocket.v1';
 
 export class FoxgloveClient {
   // topics: the topics to subscribe to; onMessage(topic, message, receiveTimeNs)
-  constructor(url, topics, { onMessage, onOpen, onClose }) {
+  constructor(url, topics, { onMessage, onOpen, onClose, onServerInfo }) {
     this.url = url;
     this.topics = new Set(topics);
     this.onMessage = onMessage;
     this.onOpen = onOpen;
     this.onClose = onClose;
+    this.onServerInfo = onServerInfo;
     this.topicBySubscription = new Map();
     this.nextSubscription = 1;
     this.decoder = new TextDecoder();
@@ -34,6 +35,7 @@ export class FoxgloveClient {
   }
 
   handleText(message) {
+    if (message.op === 'serverInfo' && this.onServerInfo) this.onServerInfo(message);
     if (message.op !== 'advertise') return;
     const subscriptions = [];
     for (const channel of message.channels) {

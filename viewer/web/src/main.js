@@ -52,6 +52,10 @@ function onMessage(topic, message) {
     case '/plumb/trajectory': {
       const counts = scene.sceneUpdate(topic, message);
       stats.posesDrawn = (counts.output || 0) + (counts.tracked || 0) + (counts.estimate || 0);
+      if (finishedRun && !fitted) {
+        scene.fitTo(topic);
+        fitted = true;
+      }
       break;
     }
     case '/plumb/map_points':
@@ -69,9 +73,20 @@ function onMessage(topic, message) {
   }
 }
 
+// `plumb view` serves a finished run: the whole trajectory in view, no follow-camera.
+let finishedRun = false, fitted = false;
+function onServerInfo(info) {
+  finishedRun = info.name === 'plumb view';
+  if (finishedRun) {
+    scene.follow = false;
+    $('follow').checked = false;
+  }
+}
+
 const url = `${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/`;
 new FoxgloveClient(url, TOPICS, {
   onMessage,
+  onServerInfo,
   onOpen: () => {
     stats.connected = true;
     $('connection').textContent = `connected to ${location.host}`;

@@ -9,7 +9,11 @@ import { LineMaterial } from 'three/examples/jsm/lines/LineMaterial.js';
 
 export class Scene {
   constructor(container) {
+    // Colours arrive as Foxglove sends them (0..1 display values): drawn as they are, not treated as
+    // linear light (which would lighten every colour on the way to the screen).
+    THREE.ColorManagement.enabled = false;
     this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+    this.renderer.outputColorSpace = THREE.LinearSRGBColorSpace;
     this.renderer.setPixelRatio(window.devicePixelRatio);
     this.renderer.setClearColor(0x101218);
     container.appendChild(this.renderer.domElement);
@@ -23,7 +27,7 @@ export class Scene {
     grid.rotation.x = Math.PI;  // in the world frame: the plane y = 0
     this.world.add(grid);
     this.camera = new THREE.PerspectiveCamera(60, 1, 0.01, 500);
-    this.camera.position.set(1.5, 2.0, 3.0);
+    this.camera.position.set(0.7, 0.9, 1.4);
     this.controls = new OrbitControls(this.camera, this.renderer.domElement);
     this.controls.enableDamping = true;
     this.groups = new Map();  // channel -> THREE.Group of its current drawing
@@ -167,6 +171,18 @@ export class Scene {
     return n;
   }
 
+  // Looks at the whole of what `channel` draws (a finished run: its trajectory), from above.
+  fitTo(channel) {
+    const group = this.groups.get(channel);
+    if (!group) return;
+    const box = new THREE.Box3().setFromObject(group);
+    if (box.isEmpty()) return;
+    const center = box.getCenter(new THREE.Vector3());
+    const size = Math.max(0.5, box.getSize(new THREE.Vector3()).length());
+    this.controls.target.copy(center);
+    this.camera.position.copy(center).add(new THREE.Vector3(0.35, 0.8, 0.5).multiplyScalar(size));
+  }
+
   // foxglove.PoseInFrame of the camera.
   cameraPose(pose) {
     const p = pose.pose.position, q = pose.pose.orientation;
@@ -174,10 +190,10 @@ export class Scene {
     this.cameraMarker.position.set(p.x, p.y, p.z);
     this.cameraMarker.quaternion.set(q.x, q.y, q.z, q.w);
     this.cameraMarker.visible = true;
-    if (first) {
+    if (first && this.follow) {
       const w = this.cameraMarker.getWorldPosition(new THREE.Vector3());
       this.controls.target.copy(w);
-      this.camera.position.copy(w).add(new THREE.Vector3(1.5, 2.0, 3.0));
+      this.camera.position.copy(w).add(new THREE.Vector3(0.7, 0.9, 1.4));
     }
   }
 }
