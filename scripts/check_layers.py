@@ -150,7 +150,8 @@ ALLOWED_FAMILIES = {
     "examples": ["std", "eigen", "plumb_installed"],
     "tools": _ALL_THIRD_PARTY,
     "tests/support": _ALL_THIRD_PARTY + ["gtest"],
-    "tests/*": _ALL_THIRD_PARTY + ["gtest", "ceres"],  # Ceres: a test-only oracle
+    # Ceres: a test-only oracle; websocketpp/asio: tests/viewer's client.
+    "tests/*": _ALL_THIRD_PARTY + ["gtest", "ceres", "websocketpp", "asio"],
     "bench": _ALL_THIRD_PARTY + ["ceres"],
     "fuzz": _ALL_THIRD_PARTY + ["zlib"],  # zlib: re-deflating mutated PNGs
 }

@@ -7,6 +7,8 @@ PACKAGES=(
   libeigen3-dev libopencv-dev libopencv-contrib-dev libpng-dev libdeflate-dev
   libopenni2-dev libv4l-dev libusb-1.0-0-dev
   libjpeg62-turbo-dev
+  libwebsocketpp-dev libasio-dev  # product: the viewer's server (plumb run --serve, plumb view; header-only)
+  chromium                        # test: the viewer page test (ctest viewer_page, headless)
   libgtest-dev libbenchmark-dev
   python3-dev python3-pybind11 pybind11-dev python3-numpy python3-pytest
   valgrind
@@ -14,6 +16,9 @@ PACKAGES=(
 )
 # libjpeg62-turbo-dev: MJPEG cameras and JPEG images in TUM folders (optional at build time).
 # valgrind: ctest instruction_budget (bench/instructions/; skipped without it).
+# node and npm (product: build the viewer page; test: tests/*_node) from Debian only when the
+# machine has none: a node installed otherwise (with its own npm) is used as it is.
+if ! command -v npm >/dev/null 2>&1; then PACKAGES+=(nodejs npm); fi
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -28,13 +33,23 @@ else
   $SUDO apt-get update -qq
   $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
-# The independent MAVLink decoder of tests/mavlink_node (npm's node-mavlink, pinned by its
-# package-lock.json), where npm is installed; without it those tests skip.
+# npm packages, each folder pinned by its package-lock.json (npm ci), where npm is installed:
+#   product: viewer/web (three.js and esbuild: the viewer page is bundled into `plumb` at build
+#            time; without them `plumb` has no page, Foxglove still works);
+#   test:    tests/mavlink_node (node-mavlink: the independent MAVLink decoder), tests/viewer_node
+#            (@foxglove/ws-protocol, playwright-core, ws: the viewer's real-client tests).
+# Without npm those tests skip.
 here="$(cd "$(dirname "$0")/.." && pwd)"
-if command -v npm >/dev/null 2>&1; then
-  if [ ! -f "$here/tests/mavlink_node/node_modules/node-mavlink/package.json" ]; then
-    npm ci --prefix "$here/tests/mavlink_node" --no-audit --no-fund
+npm_ci() {  # FOLDER MARKER_FILE
+  if [ ! -f "$here/$1/node_modules/$2" ]; then
+    npm ci --prefix "$here/$1" --no-audit --no-fund
   fi
+}
+if command -v npm >/dev/null 2>&1; then
+  npm_ci viewer/web three/package.json
+  npm_ci tests/mavlink_node node-mavlink/package.json
+  npm_ci tests/viewer_node playwright-core/package.json
 else
-  echo "install_deps: npm not found: the MAVLink decoder tests will skip (Debian: apt-get install nodejs npm)"
+  echo "install_deps: npm not found: no viewer page, and the MAVLink decoder and viewer client tests will skip" \
+       "(Debian: apt-get install nodejs npm)"
 fi
