@@ -225,9 +225,11 @@ void LiveView::publishMap() {
 
 void LiveView::publishStatus() {
   status_sent_s_ = nowS();
-  if (latency_window_.count() > 0) {
+  // p99 over the last second (or what the final tick has).
+  if (latency_window_.count() > 0 && (final_ || status_sent_s_ - latency_window_start_s_ >= 1.0)) {
     latency_p99_ms_ = double(latency_window_.percentileNs(0.99)) * 1e-6;
     latency_window_.clear();
+    latency_window_start_s_ = status_sent_s_;
   }
   const FoxgloveServerStats s = server_.stats();
   JsonWriter w;

@@ -82,8 +82,9 @@ class LiveView {
   FeedFrame last_frame_;
   double last_timestamp_s_ = 0;
   uint64_t frames_ = 0, dropped_ = 0, lost_ = 0, keyframes_seen_ = 0, relocalizations_ = 0, output_poses_ = 0;
-  runtime::LatencyHistogram latency_window_;  // the last status interval
-  double latency_p99_ms_ = -1;
+  runtime::LatencyHistogram latency_window_;  // the current second
+  double latency_window_start_s_ = 0;
+  double latency_p99_ms_ = -1;  // of the last full second
   std::vector<uint8_t> jpeg_;
 };
 
