@@ -152,7 +152,7 @@ ALLOWED_FAMILIES = {
     "tests/support": _ALL_THIRD_PARTY + ["gtest"],
     # Ceres: a test-only oracle; websocketpp/asio: tests/viewer's client.
     "tests/*": _ALL_THIRD_PARTY + ["gtest", "ceres", "websocketpp", "asio"],
-    "bench": _ALL_THIRD_PARTY + ["ceres"],
+    "bench": _ALL_THIRD_PARTY + ["ceres", "websocketpp", "asio"],  # bench/viewer's clients
     "fuzz": _ALL_THIRD_PARTY + ["zlib"],  # zlib: re-deflating mutated PNGs
 }
 

@@ -22,7 +22,7 @@ TSAN_OPTIONS="halt_on_error=1" ctest --test-dir build-tsan --output-on-failure -
 
 echo "== AddressSanitizer + UBSan: every area but system (scripts/sanitize.sh) =="
 PRESET=asan-fast bash scripts/sanitize.sh platform runtime solver pipeline odometry loop drivers devices \
-  mavlink api tools mapfile
+  mavlink api tools mapfile viewer
 
 echo "== Fuzzing: every parser, 20 s each (scripts/fuzz.sh) =="
 if command -v clang++ >/dev/null 2>&1; then

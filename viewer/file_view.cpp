@@ -10,18 +10,14 @@
 #include "viewer/json_writer.h"
 #include "viewer/live_view.h"
 #include "viewer/viewer_channels.h"
+#include "viewer/viewer_style.h"
 
 namespace plumb::viewer {
 namespace {
 
 constexpr std::size_t kMaxTrajectoryPoints = 20000;  // a view is sent once: more detail than live
 constexpr std::size_t kMaxMapPoints = 200000;
-constexpr float kFrustumDepthM = 0.08f;
-const Rgba kEstimateColor{0.20f, 0.80f, 0.35f, 1.0f};
-const Rgba kGroundTruthColor{0.75f, 0.75f, 0.78f, 1.0f};
-const Rgba kLoopColor{0.95f, 0.25f, 0.85f, 1.0f};
-const Rgba kLineColor{0.30f, 0.85f, 0.95f, 1.0f};
-const Rgba kKeyframeColor{0.35f, 0.50f, 1.00f, 0.8f};
+constexpr Rgba kEstimateColor = kOutputColor;  // estimate poses without a ground-truth pair
 
 // Green (no error) through yellow to red (the largest error of the run).
 Rgba errorColor(double error, double max_error) {

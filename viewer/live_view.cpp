@@ -6,19 +6,13 @@
 #include "drivers/image/jpeg_encoder.h"
 #include "viewer/json_writer.h"
 #include "viewer/viewer_channels.h"
+#include "viewer/viewer_style.h"
 
 namespace plumb::viewer {
 namespace {
 
 constexpr std::size_t kMaxTrajectoryPoints = 6000;  // per message: ~200 KB of JSON at most
 constexpr std::size_t kMaxKeyframesDrawn = 400;     // the newest ones
-constexpr float kFrustumDepthM = 0.08f;
-const Rgba kOutputColor{0.20f, 0.80f, 0.35f, 1.0f};
-const Rgba kTrackedColor{1.00f, 0.60f, 0.10f, 1.0f};
-const Rgba kLoopColor{0.95f, 0.25f, 0.85f, 1.0f};
-const Rgba kLineColor{0.30f, 0.85f, 0.95f, 1.0f};
-const Rgba kKeyframeColor{0.35f, 0.50f, 1.00f, 0.8f};
-const Rgba kLocalKeyframeColor{1.00f, 1.00f, 1.00f, 1.0f};
 
 uint64_t toNs(double seconds) { return seconds > 0 ? uint64_t(std::llround(seconds * 1e9)) : 0; }
 

@@ -4,9 +4,7 @@
 #include <utility>
 
 #if PLUMB_HAVE_LIBJPEG
-#include <csetjmp>
-// jpeglib.h needs FILE and size_t declared first.
-#include <jpeglib.h>
+#include "drivers/image/jpeg_errors.h"
 #endif
 
 namespace plumb {
@@ -19,27 +17,11 @@ bool looksLikeJpeg(const uint8_t* bytes, std::size_t size) {
 
 namespace {
 
-// libjpeg's error_exit must not return: keep the message and jump back into decodeRows().
-struct ErrorManager {
-  jpeg_error_mgr base;
-  std::jmp_buf jump;
-  char message[JMSG_LENGTH_MAX];
-};
-
-void onError(j_common_ptr info) {
-  auto* errors = reinterpret_cast<ErrorManager*>(info->err);
-  (*info->err->format_message)(info, errors->message);
-  std::longjmp(errors->jump, 1);
-}
-void onMessage(j_common_ptr) {}  // warnings (corrupt-data remarks) are not printed
-
 // The libjpeg calls, apart so that setjmp's frame holds no objects with destructors. The Mat is
 // created inside, after the header is known.
-bool decodeRows(const uint8_t* bytes, std::size_t size, cv::Mat& dst, ErrorManager& errors) {
+bool decodeRows(const uint8_t* bytes, std::size_t size, cv::Mat& dst, JpegErrors& errors) {
   jpeg_decompress_struct info;
-  info.err = jpeg_std_error(&errors.base);
-  errors.base.error_exit = onError;
-  errors.base.output_message = onMessage;
+  info.err = useJpegErrors(errors);
   if (setjmp(errors.jump)) {
     jpeg_destroy_decompress(&info);
     return false;
@@ -81,7 +63,7 @@ bool decodeJpeg(const uint8_t* bytes, std::size_t size, cv::Mat& dst, std::strin
     if (error) *error = "not a JPEG (no start-of-image marker)";
     return false;
   }
-  ErrorManager errors;
+  JpegErrors errors;
   errors.message[0] = '\0';
   if (!decodeRows(bytes, size, dst, errors)) {
     if (error) *error = std::string("corrupt or truncated JPEG (") + errors.message + ")";

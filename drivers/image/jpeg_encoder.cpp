@@ -4,9 +4,7 @@
 #include <cstdlib>
 
 #if PLUMB_HAVE_LIBJPEG
-#include <csetjmp>
-// jpeglib.h needs FILE and size_t declared first.
-#include <jpeglib.h>
+#include "drivers/image/jpeg_errors.h"
 #endif
 
 namespace plumb {
@@ -15,26 +13,13 @@ namespace plumb {
 
 namespace {
 
-// libjpeg's error_exit must not return: keep the message and jump back into compressRows().
-struct EncoderErrors {
-  jpeg_error_mgr base;
-  std::jmp_buf jump;
-  char message[JMSG_LENGTH_MAX];
-};
-
-void onEncoderError(j_common_ptr info) {
-  auto* errors = reinterpret_cast<EncoderErrors*>(info->err);
-  (*info->err->format_message)(info, errors->message);
-  std::longjmp(errors->jump, 1);
-}
-
-// The libjpeg calls, apart so that setjmp's frame holds no objects with destructors. libjpeg
-// mallocs the output buffer (jpeg_mem_dest); the caller copies and frees it.
-bool compressRows(const uint8_t* bgr, int width, int height, std::size_t stride, int quality, EncoderErrors& errors,
+// The libjpeg calls, apart so that setjmp's frame holds no objects with destructors. `pixels` are
+// BGR with libjpeg-turbo's extensions, else RGB. libjpeg mallocs the output buffer
+// (jpeg_mem_dest); the caller copies and frees it.
+bool compressRows(const uint8_t* pixels, int width, int height, std::size_t stride, int quality, JpegErrors& errors,
                   unsigned char** buffer, unsigned long* size) {
   jpeg_compress_struct info;
-  info.err = jpeg_std_error(&errors.base);
-  errors.base.error_exit = onEncoderError;
+  info.err = useJpegErrors(errors);
   if (setjmp(errors.jump)) {
     jpeg_destroy_compress(&info);
     return false;
@@ -52,21 +37,8 @@ bool compressRows(const uint8_t* bgr, int width, int height, std::size_t stride,
   jpeg_set_defaults(&info);
   jpeg_set_quality(&info, quality, TRUE);
   jpeg_start_compress(&info, TRUE);
-#ifndef JCS_EXTENSIONS
-  std::vector<uint8_t> rgb(std::size_t(width) * 3);
-#endif
   while (info.next_scanline < info.image_height) {
-    const uint8_t* src = bgr + std::size_t(info.next_scanline) * stride;
-#ifdef JCS_EXTENSIONS
-    JSAMPROW row = const_cast<JSAMPROW>(src);
-#else
-    for (int x = 0; x < width; ++x) {
-      rgb[std::size_t(x) * 3] = src[x * 3 + 2];
-      rgb[std::size_t(x) * 3 + 1] = src[x * 3 + 1];
-      rgb[std::size_t(x) * 3 + 2] = src[x * 3];
-    }
-    JSAMPROW row = rgb.data();
-#endif
+    JSAMPROW row = const_cast<JSAMPROW>(pixels + std::size_t(info.next_scanline) * stride);
     jpeg_write_scanlines(&info, &row, 1);
   }
   jpeg_finish_compress(&info);
@@ -82,10 +54,25 @@ bool encodeJpeg(const uint8_t* bgr, int width, int height, std::size_t stride, i
     if (error) *error = "JPEG encoder: bad image size or quality";
     return false;
   }
-  EncoderErrors errors;
+  const uint8_t* pixels = bgr;
+#ifndef JCS_EXTENSIONS
+  // Plain libjpeg reads RGB: swap into a copy.
+  std::vector<uint8_t> rgb(std::size_t(height) * stride);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const uint8_t* src = bgr + std::size_t(y) * stride + std::size_t(x) * 3;
+      uint8_t* dst = rgb.data() + std::size_t(y) * stride + std::size_t(x) * 3;
+      dst[0] = src[2];
+      dst[1] = src[1];
+      dst[2] = src[0];
+    }
+  }
+  pixels = rgb.data();
+#endif
+  JpegErrors errors;
   unsigned char* buffer = nullptr;
   unsigned long size = 0;
-  const bool ok = compressRows(bgr, width, height, stride, quality, errors, &buffer, &size);
+  const bool ok = compressRows(pixels, width, height, stride, quality, errors, &buffer, &size);
   if (ok) out->assign(buffer, buffer + size);
   std::free(buffer);
   if (!ok && error) *error = std::string("JPEG encoder: ") + errors.message;
