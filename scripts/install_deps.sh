@@ -1,28 +1,54 @@
 #!/usr/bin/env bash
 # Installs the Debian (bookworm) packages plumb needs, only those that are missing.
+#   bash scripts/install_deps.sh           what the `plumb` tool needs to build and run (the demo)
+#   bash scripts/install_deps.sh --tests   that, plus what the tests and benchmarks need (test.sh)
 # Run as root (or with sudo available). Safe to run again: does nothing when all are present.
 set -euo pipefail
-PACKAGES=(
+with_tests=0
+for arg in "$@"; do
+  case "$arg" in
+    --tests) with_tests=1 ;;
+    *) echo "install_deps: unknown argument '$arg' (usage: install_deps.sh [--tests])" >&2; exit 2 ;;
+  esac
+done
+
+# The product: a compiler, Eigen, OpenCV core + imgproc only (cmake/plumb_find_opencv.cmake; all of
+# libopencv-dev pulls VTK, GDAL, Qt, ... and was most of a 16-minute first run), image codecs and
+# the sensor libraries.
+PRODUCT_PACKAGES=(
   build-essential cmake pkg-config
-  libeigen3-dev libopencv-dev libopencv-contrib-dev libpng-dev libdeflate-dev
+  libeigen3-dev libopencv-core-dev libopencv-imgproc-dev libpng-dev libdeflate-dev
   libopenni2-dev libv4l-dev libusb-1.0-0-dev
-  libjpeg62-turbo-dev
-  libwebsocketpp-dev libasio-dev  # product: the viewer's server (plumb run --serve, plumb view; header-only)
-  chromium                        # test: the viewer page test (ctest viewer_page, headless)
+  libjpeg62-turbo-dev  # MJPEG cameras and JPEG images in TUM folders (optional at build time)
+  libwebsocketpp-dev libasio-dev  # the viewer's server (plumb run --serve, plumb view; header-only)
+)
+# Tests, benchmarks and the Python module.
+TEST_PACKAGES=(
+  libopencv-dev libopencv-contrib-dev  # oracles in tests (imgcodecs, features2d), stock-OpenCV bench
   libgtest-dev libbenchmark-dev
   python3-dev python3-pybind11 pybind11-dev python3-numpy python3-pytest
-  valgrind
+  valgrind  # ctest instruction_budget (bench/instructions/; skipped without it)
   clang libclang-rt-14-dev  # fuzz targets (scripts/fuzz.sh): libFuzzer is in libclang-rt-14-dev
+  nodejs npm  # tests/mavlink_node, tests/viewer_node (pinned npm packages); builds the viewer page
+  chromium    # the viewer page test (ctest viewer_page, headless, driven by playwright-core)
 )
-# libjpeg62-turbo-dev: MJPEG cameras and JPEG images in TUM folders (optional at build time).
-# valgrind: ctest instruction_budget (bench/instructions/; skipped without it).
-# node and npm (product: build the viewer page; test: tests/*_node) from Debian only when the
-# machine has none: a node installed otherwise (with its own npm) is used as it is.
-if ! command -v npm >/dev/null 2>&1; then PACKAGES+=(nodejs npm); fi
+
+packages=("${PRODUCT_PACKAGES[@]}")
+if [ "$with_tests" = 1 ]; then
+  packages+=("${TEST_PACKAGES[@]}")
+fi
 missing=()
-for p in "${PACKAGES[@]}"; do
+for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+# npm from a non-Debian source (nodesource, nvm) counts as present.
+if command -v npm >/dev/null 2>&1; then
+  kept=()
+  for p in "${missing[@]}"; do
+    case "$p" in nodejs|npm) ;; *) kept+=("$p") ;; esac
+  done
+  missing=("${kept[@]}")
+fi
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install_deps: all packages present"
 else
@@ -33,12 +59,12 @@ else
   $SUDO apt-get update -qq
   $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
+
 # npm packages, each folder pinned by its package-lock.json (npm ci), where npm is installed:
 #   product: viewer/web (three.js and esbuild: the viewer page is bundled into `plumb` at build
-#            time; without them `plumb` has no page, Foxglove still works);
-#   test:    tests/mavlink_node (node-mavlink: the independent MAVLink decoder), tests/viewer_node
+#            time; without npm `plumb` has no page and Foxglove/Lichtblick still work);
+#   tests:   tests/mavlink_node (node-mavlink: the independent MAVLink decoder), tests/viewer_node
 #            (@foxglove/ws-protocol, playwright-core, ws: the viewer's real-client tests).
-# Without npm those tests skip.
 here="$(cd "$(dirname "$0")/.." && pwd)"
 npm_ci() {  # FOLDER MARKER_FILE
   if [ ! -f "$here/$1/node_modules/$2" ]; then
@@ -47,9 +73,11 @@ npm_ci() {  # FOLDER MARKER_FILE
 }
 if command -v npm >/dev/null 2>&1; then
   npm_ci viewer/web three/package.json
-  npm_ci tests/mavlink_node node-mavlink/package.json
-  npm_ci tests/viewer_node playwright-core/package.json
+  if [ "$with_tests" = 1 ]; then
+    npm_ci tests/mavlink_node node-mavlink/package.json
+    npm_ci tests/viewer_node playwright-core/package.json
+  fi
 else
-  echo "install_deps: npm not found: no viewer page, and the MAVLink decoder and viewer client tests will skip" \
-       "(Debian: apt-get install nodejs npm)"
+  echo "install_deps: npm not found: plumb is built without its viewer page (Foxglove still works;" \
+       "install_deps.sh --tests installs nodejs and npm)"
 fi
