@@ -14,7 +14,7 @@ namespace plumb {
 
 uint64_t allocationCount();    // operator new calls since start (threads excluded below not counted)
 uint64_t deallocationCount();  // operator delete calls (non-null) since start
-uint64_t allocatedBytes();     // bytes requested through operator new since start
+uint64_t allocatedBytes();     // bytes requested through operator new since start (every thread)
 
 // A thread that is no part of any frame path (the viewer's server thread, viewer/) calls this once
 // at its start: from then on its allocations go to excludedAllocationCount() instead, so
