@@ -78,7 +78,9 @@ int runView(int argc, char** argv) {
 
   viewer::FileViewInput input;
   input.title = args.get("out");
-  st = readTumTrajectory(args.get("out"), &input.estimate).withContext("--out");
+  TrajectoryReadOptions read_options;
+  read_options.keep_lost_markers = true;  // `# <t> lost` / `dropped` lines break the drawn strips
+  st = readTumTrajectory(args.get("out"), &input.estimate, read_options).withContext("--out");
   if (!st.ok()) return fail(st.message());
   if (args.has("gt")) {
     st = readTumTrajectory(args.get("gt"), &input.ground_truth).withContext("--gt");
