@@ -100,6 +100,19 @@ void FoxgloveServer::Impl::setUp() {
   server.set_fail_handler([this](Handle h) { onClose(h); });
   server.set_message_handler([this](Handle h, WsServer::message_ptr m) { onMessage(h, m); });
   server.set_http_handler([this](Handle h) { onHttp(h); });
+  // Once the TCP connection exists (the socket is not open before accept): a fixed send buffer
+  // (which also turns off the kernel's send-buffer autotuning, up to 4 MiB on loopback) and no
+  // Nagle delay for the small pose messages.
+  server.set_tcp_post_init_handler([this](Handle h) {
+    websocketpp::lib::error_code ec;
+    WsServer::connection_ptr con = server.get_con_from_hdl(h, ec);
+    if (ec || !con) return;
+    asio::error_code aec;
+    con->get_socket().set_option(asio::ip::tcp::no_delay(true), aec);
+    if (options.socket_send_buffer_bytes > 0) {
+      con->get_socket().set_option(asio::socket_base::send_buffer_size(options.socket_send_buffer_bytes), aec);
+    }
+  });
   server.set_pong_handler([this](Handle h, std::string) {
     auto it = clients.find(h);
     if (it != clients.end()) it->second.awaiting_pong = false;

@@ -46,6 +46,10 @@ struct FoxgloveServerOptions {
   // Per client, beyond what the kernel's socket buffer holds: more and its messages are dropped
   // (a viewer that far behind is seconds late; newer messages replace what it missed).
   std::size_t max_queued_bytes = 1024 * 1024;
+  // The kernel's send buffer per client (SO_SNDBUF; Linux doubles it). Small on purpose: what a
+  // slow client has not taken waits in the queue above, where it is bounded and counted, not in
+  // megabytes of kernel buffer that arrive seconds late. 64 KiB still moves ~6 MB/s at 20 ms RTT.
+  int socket_send_buffer_bytes = 64 * 1024;
   int ping_interval_ms = 5000;  // a client that does not answer a ping within this is closed
   int thread_nice = 10;         // the server thread's nice value (0: unchanged)
 };

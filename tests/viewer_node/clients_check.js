@@ -61,8 +61,14 @@ async function main() {
   const run = await startServing(plumb, [...common, path.join(work, 'served.json'), '--out', served, '--serve', '0']);
   const good = [];
   for (let i = 0; i < 20; i++) good.push(connect(run.port, 'subscribe'));
-  const silent = connect(run.port, 'subscribe');
-  silent.ws.on('open', () => setTimeout(() => silent.ws._socket.pause(), 300));  // subscribes, then never reads
+  // Subscribes to the ten channels plumb advertises (ids 1..10) without reading the advertisement,
+  // then never reads at all: its socket stays at the kernel's initial receive buffer.
+  const silent = connect(run.port, null);
+  silent.ws.on('open', () => {
+    silent.ws._socket.pause();
+    const subscriptions = Array.from({ length: 10 }, (_, i) => ({ id: i + 1, channelId: i + 1 }));
+    silent.ws.send(JSON.stringify({ op: 'subscribe', subscriptions }));
+  });
   const vanishing = connect(run.port, 'subscribe');
   setTimeout(() => vanishing.ws.terminate(), 1500);
   const bad = {
@@ -100,8 +106,11 @@ async function main() {
   const dropped = summaryNumber(output, /dropped for slow clients (\d+)/);
   const malformed = summaryNumber(output, /(\d+) closed for malformed messages/);
   const peak = summaryNumber(output, /peak (\d+) at once/);
-  // The client that never reads either fills its queue (messages dropped, counted) or stops
-  // answering pings first (closed, counted): which one depends on the kernel's socket buffers.
+  // The client that never reads fills its queue (1 MiB above a 128 KiB kernel buffer): its
+  // messages are dropped and counted; after 5-10 s without a pong it is closed, counted too.
+  // Which comes first depends on how fast this machine runs the scene (how much data there is
+  // per second); either way the run must not notice. tests/viewer/foxglove_server_test.cpp
+  // proves the dropping on its own.
   const timedOut = summaryNumber(output, /(\d+) for not answering/);
   check(dropped > 0 || timedOut >= 1, `the client that never reads was neither dropped from nor closed:\n${output}`);
   check(malformed === Object.keys(bad).length, `${malformed} clients closed as malformed, expected ${Object.keys(bad).length}`);

@@ -50,7 +50,7 @@ function pixelsOf(file, named) {
 }
 
 async function live(plumb, work) {
-  const run = await startServing(plumb, ['run', '--dataset', 'paced:synth:textured:1:300', '--mode', 'fast',
+  const run = await startServing(plumb, ['run', '--dataset', 'paced:synth:textured:1:150', '--mode', 'fast',
                                          '--out', path.join(work, 'live.txt'), '--serve', '0']);
   const stats = await openPage(run.port, 60, path.join(work, 'live.png'));
   const { code } = await run.exited;
@@ -69,14 +69,14 @@ async function view(plumb, work) {
     const r = spawnSync(plumb, args, { encoding: 'utf8' });
     check(r.status === 0, `plumb ${args.join(' ')} failed:\n${r.stdout}${r.stderr}`);
   };
-  run(['synth', '--preset', 'textured', '--seed', '2', '--frames', '200', '--depth-noise', '--pixel-noise', '1', '--out', scene]);
+  run(['synth', '--preset', 'textured', '--seed', '2', '--frames', '120', '--depth-noise', '--pixel-noise', '1', '--out', scene]);
   const est = path.join(work, 'estimate.txt'), map = path.join(work, 'run.map'), stats = path.join(work, 'run.json');
   run(['run', '--dataset', scene, '--out', est, '--save-map', map, '--stats', stats]);
   const served = await startServing(plumb, ['view', '--out', est, '--gt', path.join(scene, 'groundtruth.txt'),
                                             '--map', map, '--stats', stats, '--serve', '0']);
   let page;
   try {
-    page = await openPage(served.port, 150, path.join(work, 'view.png'));
+    page = await openPage(served.port, 100, path.join(work, 'view.png'));
   } finally {
     served.child.kill('SIGTERM');
   }
