@@ -150,6 +150,12 @@ void FoxgloveServer::Impl::setUp() {
 
 bool FoxgloveServer::Impl::onValidate(Handle h) {
   WsServer::connection_ptr con = server.get_con_from_hdl(h);
+  if (clients.size() >= options.max_clients) {
+    ++stats.clients_refused;
+    con->set_status(websocketpp::http::status_code::service_unavailable);
+    con->set_body("plumb's viewer already serves " + std::to_string(clients.size()) + " clients\n");
+    return false;
+  }
   for (const std::string& p : con->get_requested_subprotocols()) {
     if (p == kSubprotocol) {
       con->select_subprotocol(kSubprotocol);

@@ -51,6 +51,7 @@ struct FoxgloveServerOptions {
   // megabytes of kernel buffer that arrive seconds late. 64 KiB still moves ~6 MB/s at 20 ms RTT.
   int socket_send_buffer_bytes = 64 * 1024;
   int ping_interval_ms = 5000;  // a client that does not answer a ping within this is closed
+  std::size_t max_clients = 64;  // more are refused at the handshake (HTTP 503): bounded memory
   int thread_nice = 10;         // the server thread's nice value (0: unchanged)
 };
 
@@ -62,7 +63,7 @@ struct FoxgloveChannel {
 
 struct FoxgloveServerStats {
   uint64_t clients_accepted = 0;
-  uint64_t clients_refused = 0;           // handshake without the foxglove.websocket.v1 subprotocol
+  uint64_t clients_refused = 0;           // no foxglove.websocket.v1 subprotocol, or max_clients reached
   uint64_t clients_closed_malformed = 0;  // malformed or oversized client messages
   uint64_t clients_timed_out = 0;         // did not answer a ping
   uint64_t messages_sent = 0;

@@ -126,6 +126,22 @@ TEST(FoxgloveServer, AClientThatNeverReadsHasMessagesDroppedWhileThePublisherGoe
   EXPECT_LT(longest_tick_us.load(), 500000);
 }
 
+TEST(FoxgloveServer, RefusesClientsBeyondItsLimit) {
+  FoxgloveServerOptions o = loopback(1 << 20);
+  o.max_clients = 1;
+  FoxgloveServer server(o, oneChannel(), {});
+  ASSERT_TRUE(server.start([] {}).ok());
+  TestClient first(server.boundPort());
+  first.runFor(std::chrono::milliseconds(500));
+  TestClient second(server.boundPort());
+  second.runFor(std::chrono::milliseconds(500));
+  server.stop(0);
+  EXPECT_TRUE(first.subscribed);
+  EXPECT_FALSE(second.subscribed);
+  EXPECT_EQ(server.stats().clients_accepted, 1u);
+  EXPECT_EQ(server.stats().clients_refused, 1u);
+}
+
 TEST(FoxgloveServer, RefusesAnAddressItCannotBind) {
   FoxgloveServerOptions o;
   o.host = "192.0.2.1";  // TEST-NET-1: no interface of this machine has it, nothing is sent
