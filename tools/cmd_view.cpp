@@ -10,7 +10,7 @@
 #include <thread>
 
 #include "drivers/trajectory/trajectory_io.h"
-#include "tools/args.h"
+#include "tools/flags.h"
 #include "tools/command.h"
 #include "tools/map_files.h"
 
@@ -25,17 +25,38 @@
 namespace plumb::tools {
 namespace {
 
-void printViewUsage() {
+struct ViewOptions {
+  std::string out, gt, map, stats, serve;
+};
+
+FlagTable viewFlagTable(ViewOptions* o) {
+  FlagTable t;
+  t.text("out", "FILE", &o->out, "the run's trajectory (TUM format, `plumb run --out`); required")
+      .text("gt", "FILE", &o->gt, "ground truth: the estimate is aligned to it and coloured by its error")
+      .text("map", "FILE", &o->map, "the run's map (`plumb run --save-map`): keyframes, loop edges, points, lines")
+      .text("stats", "FILE", &o->stats, "the run's statistics (`plumb run --stats`) on the status panel")
+      .text("serve", "PORT|HOST:PORT", &o->serve,
+            "where to serve; required. PORT alone: this machine only; HOST:PORT binds\n"
+            "HOST and anyone who reaches it can watch");
+  return t;
+}
+
+void printViewUsage(const FlagTable& table) {
   std::printf(
       "usage: plumb view --out TRAJ [--gt GT] [--map M.map] [--stats S.json] --serve PORT|HOST:PORT\n"
-      "  Serves a finished run until Ctrl-C: open http://HOST:PORT/ in a browser, or connect\n"
-      "  Foxglove/Lichtblick to ws://HOST:PORT (docs/VIEWER.md). PORT alone: this machine only;\n"
-      "  HOST:PORT binds HOST and anyone who reaches it can watch.\n"
-      "  --out FILE    the run's trajectory (TUM format, `plumb run --out`)\n"
-      "  --gt FILE     ground truth: the estimate is aligned to it and coloured by its error\n"
-      "  --map FILE    the run's map (`plumb run --save-map`): keyframes, loop edges, points, lines\n"
-      "  --stats FILE  the run's statistics (`plumb run --stats`) on the status panel\n"
-      "  --serve ADDR  where to serve (required)\n");
+      "Serves a finished run until Ctrl-C: open http://HOST:PORT/ in a browser, or connect\n"
+      "Foxglove/Lichtblick to ws://HOST:PORT (docs/VIEWER.md).\n%s",
+      table.usage().c_str());
+}
+
+// The command line; a usage error (exit 2) as a Status. *help: --help was given.
+Status parseView(int argc, char** argv, FlagTable* table, const ViewOptions& o, bool* help) {
+  PLUMB_RETURN_IF_ERROR(table->parse(argc, argv));
+  *help = table->help();
+  if (*help) return Status::Ok();
+  if (!table->positional().empty()) return Status::Error("unexpected argument " + table->positional()[0]);
+  if (o.out.empty() || o.serve.empty()) return Status::Error("--out and --serve are required");
+  return Status::Ok();
 }
 
 int fail(const std::string& message, int code = kExitFailed) {
@@ -59,41 +80,37 @@ Status readText(const std::string& path, std::string* out) {
 }
 
 int runView(int argc, char** argv) {
-  Args args(argc, argv, {"out", "gt", "map", "stats", "serve"}, {});
-  if (args.help()) {
-    printViewUsage();
+  ViewOptions o;
+  FlagTable table = viewFlagTable(&o);
+  bool help = false;
+  Status st = parseView(argc, argv, &table, o, &help);
+  if (help) {
+    printViewUsage(table);
     return kExitOk;
   }
-  if (!args.error().empty() || !args.positional().empty() || !args.has("out") || !args.has("serve")) {
-    std::fprintf(stderr, "plumb view: %s\n",
-                 !args.error().empty() ? args.error().c_str()
-                 : !args.positional().empty() ? ("unexpected argument " + args.positional()[0]).c_str()
-                                              : "--out and --serve are required");
-    printViewUsage();
-    return kExitUsage;
-  }
+  if (!st.ok()) return fail(st.message() + " (see plumb view --help)", kExitUsage);
   viewer::ServeAddress address;
-  Status st = viewer::parseServeAddress(args.get("serve"), &address);
+  st = viewer::parseServeAddress(o.serve, &address);
   if (!st.ok()) return fail(st.message(), kExitUsage);
 
   viewer::FileViewInput input;
-  input.title = args.get("out");
+  input.title = o.out;
   TrajectoryReadOptions read_options;
   read_options.keep_lost_markers = true;  // `# <t> lost` / `dropped` lines break the drawn strips
-  st = readTumTrajectory(args.get("out"), &input.estimate, read_options).withContext("--out");
+  st = readTumTrajectory(o.out, &input.estimate, read_options).withContext("--out");
   if (!st.ok()) return fail(st.message());
-  if (args.has("gt")) {
-    st = readTumTrajectory(args.get("gt"), &input.ground_truth).withContext("--gt");
+  if (!o.gt.empty()) {
+    st = readTumTrajectory(o.gt, &input.ground_truth).withContext("--gt");
     if (!st.ok()) return fail(st.message());
   }
   loop::SavedMap map;
-  if (args.has("map")) {
-    st = loadMapFile(args.get("map"), &map);
+  if (!o.map.empty()) {
+    st = loadMapFile(o.map, &map);
     if (!st.ok()) return fail(st.message());
     input.map = &map;
   }
-  if (args.has("stats")) {
-    st = readText(args.get("stats"), &input.stats_json);
+  if (!o.stats.empty()) {
+    st = readText(o.stats, &input.stats_json);
     if (!st.ok()) return fail("--stats: " + st.message());
   }
   viewer::FileView view;
@@ -136,11 +153,15 @@ int runView(int argc, char** argv) {
 #else
 
 int runView(int argc, char** argv) {
-  Args args(argc, argv, {"out", "gt", "map", "stats", "serve"}, {});
-  if (args.help()) {
-    printViewUsage();
+  ViewOptions o;
+  FlagTable table = viewFlagTable(&o);
+  bool help = false;
+  const Status st = parseView(argc, argv, &table, o, &help);
+  if (help) {
+    printViewUsage(table);
     return kExitOk;
   }
+  if (!st.ok()) return fail(st.message() + " (see plumb view --help)", kExitUsage);
   return fail("this plumb was built without the viewer (install libwebsocketpp-dev libasio-dev and rebuild with "
               "-DPLUMB_VIEWER=ON, docs/VIEWER.md)");
 }

@@ -14,15 +14,19 @@ struct RunServe::Impl {
   std::unique_ptr<viewer::RunViewer> viewer;
 };
 
-Status RunServe::start(const std::string& spec, OdometrySink& outputs, const std::string& mode,
-                       const std::string& source) {
+Status checkServeSpec(const std::string& spec) {
+  viewer::ServeAddress address;
+  return spec.empty() ? Status::Ok() : viewer::parseServeAddress(spec, &address);
+}
+
+Status RunServe::start(const std::string& spec, const std::string& mode, const std::string& source) {
   if (spec.empty()) return Status::Ok();
   viewer::ServeAddress address;
   PLUMB_RETURN_IF_ERROR(viewer::parseServeAddress(spec, &address));
   viewer::LiveViewOptions options;
   options.mode = mode;
   options.source = source;
-  PLUMB_RETURN_IF_ERROR(viewer::RunViewer::start(address, outputs, options, &impl_->viewer));
+  PLUMB_RETURN_IF_ERROR(viewer::RunViewer::start(address, options, &impl_->viewer));
   std::fprintf(stderr, "plumb run: viewer at %s (Foxglove/Lichtblick: ws://%s:%d)%s\n",
                viewer::serveUrl(address.host, impl_->viewer->port()).c_str(),
                address.host.find(':') != std::string::npos ? ("[" + address.host + "]").c_str() : address.host.c_str(),
@@ -31,7 +35,9 @@ Status RunServe::start(const std::string& spec, OdometrySink& outputs, const std
   return Status::Ok();
 }
 
-OdometrySink* RunServe::sink() { return impl_->viewer ? &impl_->viewer->sink() : nullptr; }
+OdometrySink* RunServe::wrap(OdometrySink& outputs) {
+  return impl_->viewer ? &impl_->viewer->wrap(outputs) : nullptr;
+}
 
 void RunServe::stop() {
   if (!impl_->viewer) return;
@@ -43,14 +49,16 @@ void RunServe::stop() {
 
 struct RunServe::Impl {};
 
-Status RunServe::start(const std::string& spec, OdometrySink&, const std::string&, const std::string&) {
+Status checkServeSpec(const std::string& spec) {
   if (spec.empty()) return Status::Ok();
   return Status::Error(
       "--serve: this plumb was built without the viewer (install libwebsocketpp-dev libasio-dev and rebuild with "
       "-DPLUMB_VIEWER=ON, docs/VIEWER.md)");
 }
 
-OdometrySink* RunServe::sink() { return nullptr; }
+Status RunServe::start(const std::string& spec, const std::string&, const std::string&) { return checkServeSpec(spec); }
+
+OdometrySink* RunServe::wrap(OdometrySink&) { return nullptr; }
 void RunServe::stop() {}
 
 #endif

@@ -1,8 +1,9 @@
 #pragma once
-// `plumb run --serve PORT|HOST:PORT` (docs/VIEWER.md): starts the viewer (viewer/run_viewer.h)
-// before the run and stops it after, printing what it did. Kept apart from cmd_run.cpp so the run
-// command only asks for sink() and calls stop(). Without the viewer in this build (PLUMB_VIEWER
-// off) start() refuses a --serve with how to get it.
+// `plumb run --serve PORT|HOST:PORT` (docs/VIEWER.md), in the run command's steps
+// (tools/run_command.h): the plan checks the address and starts the server (a port in use fails
+// the run before any frame); the run wraps the outputs in the viewer's decorator and stops the
+// server after, printing what it did. Without the viewer in this build (PLUMB_VIEWER off) start()
+// refuses a --serve with how to get it.
 #include <memory>
 #include <string>
 
@@ -11,14 +12,23 @@
 
 namespace plumb::tools {
 
+// A usage error for a malformed spec ('' = off is fine), or when this build has no viewer.
+Status checkServeSpec(const std::string& spec);
+
 class RunServe {
  public:
   RunServe();
   ~RunServe();
-  // spec '' = off (nothing happens). `outputs` must outlive this object.
-  Status start(const std::string& spec, OdometrySink& outputs, const std::string& mode, const std::string& source);
-  OdometrySink* sink();  // the decorator to run with, nullptr when off
-  void stop();           // the final state reaches the clients, then the server ends
+  RunServe(const RunServe&) = delete;
+  RunServe& operator=(const RunServe&) = delete;
+
+  // Plan, after checkServeSpec: spec '' = off (nothing happens); else binds and serves.
+  Status start(const std::string& spec, const std::string& mode, const std::string& source);
+  // Run: the sink to run with, a decorator around `outputs` (which must outlive the run); nullptr
+  // when off.
+  OdometrySink* wrap(OdometrySink& outputs);
+  // After the run: the final state reaches the clients, the server ends, its summary is printed.
+  void stop();
 
  private:
   struct Impl;

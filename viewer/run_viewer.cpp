@@ -14,12 +14,10 @@ namespace {
 constexpr int64_t kImageIntervalNs = 100'000'000;
 }  // namespace
 
-Status RunViewer::start(const ServeAddress& address, OdometrySink& inner, LiveViewOptions options,
-                        std::unique_ptr<RunViewer>* out) {
+Status RunViewer::start(const ServeAddress& address, LiveViewOptions options, std::unique_ptr<RunViewer>* out) {
   std::unique_ptr<RunViewer> v(new RunViewer());
   v->feed_ = std::make_unique<RunFeed>();
   v->feed_->setImageIntervalNs(kImageIntervalNs);
-  v->sink_ = std::make_unique<ViewerSink>(inner, *v->feed_);
   FoxgloveServerOptions server_options;
   server_options.host = address.host;
   server_options.port = address.port;
@@ -34,6 +32,11 @@ Status RunViewer::start(const ServeAddress& address, OdometrySink& inner, LiveVi
 }
 
 RunViewer::~RunViewer() { stop(0); }
+
+OdometrySink& RunViewer::wrap(OdometrySink& inner) {
+  sink_ = std::make_unique<ViewerSink>(inner, *feed_);
+  return *sink_;
+}
 
 void RunViewer::stop(double flush_seconds) {
   if (stopped_) return;

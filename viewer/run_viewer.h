@@ -2,7 +2,7 @@
 // RunViewer: everything `plumb run --serve` adds, in one object (docs/VIEWER.md):
 //   RunFeed (preallocated hand-off) <- ViewerSink (decorator around the run's sink)
 //   FoxgloveServer (own thread) -> LiveView::tick drains the feed and publishes.
-// The run calls runOdometry with sink() instead of its outputs; nothing else changes.
+// The run calls runOdometry with wrap(outputs) instead of its outputs; nothing else changes.
 #include <memory>
 #include <string>
 
@@ -18,12 +18,13 @@ namespace plumb::viewer {
 
 class RunViewer {
  public:
-  // Binds `address` and starts serving; `inner` (the run's outputs) must outlive the viewer.
-  static Status start(const ServeAddress& address, OdometrySink& inner, LiveViewOptions options,
-                      std::unique_ptr<RunViewer>* out);
+  // Binds `address` and starts serving (clients may connect before the run starts).
+  static Status start(const ServeAddress& address, LiveViewOptions options, std::unique_ptr<RunViewer>* out);
   ~RunViewer();
 
-  OdometrySink& sink() { return *sink_; }
+  // The sink to run with: the viewer's decorator around `inner` (the run's outputs, which must
+  // outlive the run). Once per run.
+  OdometrySink& wrap(OdometrySink& inner);
   int port() const { return server_->boundPort(); }
   // After the run: the final state is published, clients get up to flush_seconds to receive it,
   // then they are closed and the thread joins.

@@ -125,7 +125,7 @@ RunNumbers runOnce(const std::string& dataset, runtime::RunMode mode, int client
   std::vector<std::unique_ptr<BenchClient>> watching;
   if (clients > 0) {
     viewer::ServeAddress address;  // 127.0.0.1, any free port
-    check(viewer::RunViewer::start(address, outputs, viewer::LiveViewOptions{"bench", dataset}, &viewer));
+    check(viewer::RunViewer::start(address, viewer::LiveViewOptions{"bench", dataset}, &viewer));
     for (int i = 0; i < clients; ++i) watching.push_back(std::make_unique<BenchClient>(viewer->port()));
     for (int wait = 0; wait < 500; ++wait) {
       bool all = true;
@@ -136,7 +136,7 @@ RunNumbers runOnce(const std::string& dataset, runtime::RunMode mode, int client
   }
   OdometryRunResult result;
   SourceCapture capture(*source);
-  check(runOdometry(capture, *system, viewer ? viewer->sink() : outputs, options, &result));
+  check(runOdometry(capture, *system, viewer ? viewer->wrap(outputs) : outputs, options, &result));
   RunNumbers n;
   if (viewer) {
     viewer->stop(1.0);

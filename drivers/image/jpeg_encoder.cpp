@@ -4,7 +4,9 @@
 #include <cstdlib>
 
 #if PLUMB_HAVE_LIBJPEG
-#include "drivers/image/jpeg_errors.h"
+#include <csetjmp>
+// jpeglib.h needs FILE and size_t declared first.
+#include <jpeglib.h>
 #endif
 
 namespace plumb {
@@ -13,13 +15,29 @@ namespace plumb {
 
 namespace {
 
+// libjpeg's error_exit must not return: keep the message and jump back into compressRows().
+struct EncoderErrors {
+  jpeg_error_mgr base;
+  std::jmp_buf jump;
+  char message[JMSG_LENGTH_MAX];
+};
+
+void onEncoderError(j_common_ptr info) {
+  auto* errors = reinterpret_cast<EncoderErrors*>(info->err);
+  (*info->err->format_message)(info, errors->message);
+  std::longjmp(errors->jump, 1);
+}
+void onEncoderMessage(j_common_ptr) {}  // nothing is printed
+
 // The libjpeg calls, apart so that setjmp's frame holds no objects with destructors. `pixels` are
 // BGR with libjpeg-turbo's extensions, else RGB. libjpeg mallocs the output buffer
 // (jpeg_mem_dest); the caller copies and frees it.
-bool compressRows(const uint8_t* pixels, int width, int height, std::size_t stride, int quality, JpegErrors& errors,
+bool compressRows(const uint8_t* pixels, int width, int height, std::size_t stride, int quality, EncoderErrors& errors,
                   unsigned char** buffer, unsigned long* size) {
   jpeg_compress_struct info;
-  info.err = useJpegErrors(errors);
+  info.err = jpeg_std_error(&errors.base);
+  errors.base.error_exit = onEncoderError;
+  errors.base.output_message = onEncoderMessage;
   if (setjmp(errors.jump)) {
     jpeg_destroy_compress(&info);
     return false;
@@ -69,7 +87,8 @@ bool encodeJpeg(const uint8_t* bgr, int width, int height, std::size_t stride, i
   }
   pixels = rgb.data();
 #endif
-  JpegErrors errors;
+  EncoderErrors errors;
+  errors.message[0] = '\0';
   unsigned char* buffer = nullptr;
   unsigned long size = 0;
   const bool ok = compressRows(pixels, width, height, stride, quality, errors, &buffer, &size);
