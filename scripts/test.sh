@@ -30,7 +30,7 @@ elapsed "ThreadSanitizer done"
 
 echo "== AddressSanitizer + UBSan: every area but system (scripts/sanitize.sh) =="
 PRESET=asan-fast bash scripts/sanitize.sh platform runtime solver pipeline odometry loop drivers devices \
-  mavlink api tools mapfile
+  mavlink api tools mapfile viewer
 elapsed "AddressSanitizer done"
 
 echo "== Fuzzing: every parser, 20 s each (scripts/fuzz.sh) =="

@@ -226,9 +226,9 @@ Status RunOutputs::onRetiredKeyframe(const RetiredKeyframe& kf) {
 }
 
 Status runToOutputs(FrameSource& source, const SystemOptions& system_options, const OdometryRunOptions& run_options,
-                    RunOutputs& outputs, RunRecord* record) {
+                    RunOutputs& outputs, RunRecord* record, OdometrySink* sink) {
   SourceCapture capture(source, run_options.stop);
-  const Status status = runOdometry(capture, system_options, outputs, run_options, &record->run);
+  const Status status = runOdometry(capture, system_options, sink != nullptr ? *sink : outputs, run_options, &record->run);
   // The outputs hold what was computed whatever ended the run, but a run that produced no frame
   // (it failed or was stopped before its first one) replaces no file: an older trajectory of that
   // name is worth more than an empty one.

@@ -114,7 +114,9 @@ struct RunRecord {
 // `outputs` (opened when the run has been checked, closed after, also when the run failed: what
 // was computed is kept; a run that produced no frame replaces no file). The options were validated
 // by the caller's plan (tools/run_plan.cpp).
+// `sink`: what the run calls when not `outputs` itself, i.e. a decorator that forwards to
+// `outputs` (the viewer's, viewer/viewer_sink.h); nullptr: `outputs`.
 Status runToOutputs(FrameSource& source, const SystemOptions& system_options, const OdometryRunOptions& run_options,
-                    RunOutputs& outputs, RunRecord* record);
+                    RunOutputs& outputs, RunRecord* record, OdometrySink* sink = nullptr);
 
 }  // namespace plumb::tools

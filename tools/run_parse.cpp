@@ -66,6 +66,10 @@ FlagTable runFlagTable(RunCommandOptions* o) {
       .text("mavlink", "ENDPOINT", &o->mavlink,
             "MAVLink v2 ODOMETRY + HEARTBEAT to an autopilot, as each pose is tracked:\n"
             "udp:HOST:PORT or serial:DEVICE:BAUD (frames: docs/MAVLINK.md)")
+      .text("serve", "PORT|HOST:PORT", &o->serve,
+            "watch live: Foxglove WebSocket server + page at http://HOST:PORT/ (PORT\n"
+            "alone: this machine only; HOST:PORT binds HOST: anyone who reaches it can\n"
+            "watch; docs/VIEWER.md). Read-only: the outputs are the same without it")
       .section("schedule (capture -> extract -> track -> map, docs/RUNTIME.md):")
       .text("mode", "M", &o->mode,
             "deterministic (default: the stages in lock-step on one thread, the\n"

@@ -176,7 +176,13 @@ bool LoopCloser::addKeyframe(const LoopKeyframe& record) {
     groups_.clear();
   }
   (void)database_.insert(r.id, descriptors);  // sized for capacity + 1: cannot fail
-  if (accepted) optimise();
+  if (accepted) {
+    optimise();
+    // Which loop made the correction, for viewers: the edge just accepted, at the optimised pose.
+    const LoopEdge& edge = loop_edges_.back();
+    correction_.loop_candidate_id = edge.candidate_id;
+    if (!pose(edge.candidate_id, &correction_.T_world_candidate)) correction_.loop_candidate_id = 0;
+  }
   if (int(order_.size()) > options_.capacity) cullOne();
   stats_.graph_nodes = order_.size();
   stats_.peak_graph_nodes = std::max<uint64_t>(stats_.peak_graph_nodes, order_.size());

@@ -296,6 +296,7 @@ bool OdometrySystem::applyLoopCorrection() {
     return false;
   }
   ++mapping_.stats.loop_corrections_applied;
+  mapping_.last_correction = *correction;
   const LocalMap& snapshot = mapping_.mapper->localMap();
   snapshots_->writeBuffer() = snapshot;
   snapshots_->publish(snapshot.version);

@@ -154,6 +154,9 @@ class OdometrySystem {
   // else (docs/LOOP.md "Correction"); applyLoopCorrection() does the same at the end of a run.
   runtime::LatestSnapshot<MapCorrection>& loopCorrections() { return *corrections_; }
   bool applyLoopCorrection();
+  // Mapping side: the newest correction applyLoopCorrection() applied (a copy; keyframe_id 0
+  // before the first). Viewers draw loop edges from it.
+  const MapCorrection& lastLoopCorrection() const { return mapping_.last_correction; }
   // The mapper, read by the mapping side's own thread (loop records).
   const LocalMapper& mapper() const { return *mapping_.mapper; }
   const OdometryStats& stats() const { return mapping_.stats; }
@@ -195,6 +198,7 @@ class OdometrySystem {
     OdometryStats stats;
     FrameOutput output;
     uint64_t correction_version = 0;  // newest loop correction seen (0: none)
+    MapCorrection last_correction;    // newest one applied
     explicit MappingSide(int delay_frames) : trajectory(delay_frames) {}
   };
 

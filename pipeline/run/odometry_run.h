@@ -46,6 +46,17 @@
 
 namespace plumb {
 
+// What OdometrySink::onFrameView shows of a frame after mapping.
+struct FrameView {
+  const FrameOutput& output;   // the frame, as onFrame had it
+  const RgbdImage& image;      // its colour and depth images, as captured
+  const LocalMap& local_map;   // the mapping side's local map now (LocalMap::version: changed when)
+  const OdometryStats& stats;  // the mapping side's counters (loop_corrections_applied, ...)
+  // The newest loop correction the mapping side applied (valid when stats.loop_corrections_applied
+  // > 0): a viewer draws the loop edge from it.
+  const MapCorrection& last_loop_correction;
+};
+
 // Where a run's results go. Called on the map stage's thread, in frame order.
 class OdometrySink {
  public:
@@ -65,6 +76,11 @@ class OdometrySink {
   virtual Status onFinishedFrame(const FinishedFrame& frame) = 0;
   // A keyframe that left the map, with its final pose and covariance.
   virtual Status onRetiredKeyframe(const RetiredKeyframe&) { return Status::Ok(); }
+  // For viewers (viewer/, docs/VIEWER.md): after onFrame of a tracked (not dropped) frame and any
+  // loop correction made for it, on the map stage's thread, a read-only look at what the frame
+  // left (below). Nothing else changes those objects during the call, and they are valid only
+  // during it. Must not block or allocate: copy what you need into preallocated storage.
+  virtual void onFrameView(const FrameView&) {}
 };
 
 struct OdometryRunOptions {

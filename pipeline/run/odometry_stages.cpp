@@ -159,6 +159,8 @@ Status MapStage::process(OdometrySlot& slot, const runtime::FrameStamps& stamps)
   // frame retired carry poses from before the correction, so they go to the closer with the epoch
   // of before it.
   if (loop_ != nullptr && loop_->synchronous()) system_.applyLoopCorrection();
+  sink_.onFrameView(FrameView{out, slot.image, system_.mapper().localMap(), system_.stats(),
+                              system_.lastLoopCorrection()});
   // Process-wide count, read on this thread after each frame: from the first frame at or after
   // warm-up to the last one finished before the input ended, every thread's allocations are
   // included. The count is read before the flag, so a reading taken after a stage thread began
