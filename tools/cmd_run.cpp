@@ -44,7 +44,9 @@ void printRunUsage() {
       "                       keyframe's pose in the final loop-closing pose graph (docs/LOOP.md)\n"
       "  --no-loops           no loop closing (--out-optimized then equals --out)\n"
       "  --covariance FILE    per keyframe: timestamp and the 21 upper-triangle entries of its 6x6\n"
-      "                       pose covariance from local BA (docs/ODOMETRY.md)\n"
+      "                       pose covariance from local BA, then its pose relative to the previous\n"
+      "                       keyframe with that covariance (docs/DATA_FORMATS.md)\n"
+      "  --track-covariance FILE  per tracked frame: pose and its covariances as MAVLink sends them\n"
       "  --stats FILE         statistics as JSON (states, keyframes, map, ms per frame, RSS, options)\n"
       "  --max-frames N       stop after N frames\n"
       "  --skip-frames N      start at the source's frame N (the first N are read and discarded; 0..)\n"
@@ -107,7 +109,7 @@ int runRun(int argc, char** argv) {
   Args args(argc, argv,
             withScheduleFlags({"dataset", "camera", "out", "line-samples", "covariance", "stats", "max-frames",
                                "gt", "output-delay", "rss-every", "mavlink", "report-every", "out-optimized",
-                               "skip-frames", "save-map", "load-map"},
+                               "skip-frames", "save-map", "load-map", "track-covariance"},
                               scheduleValueFlags()),
             withScheduleFlags({"no-lines", "synth-noise", "progress", "trace", "count-allocations", "discard-trajectory",
                                "no-loops"},
@@ -176,6 +178,7 @@ int runRun(int argc, char** argv) {
   io.addOutput("--save-map", args.get("save-map"));
   io.addOutput("--out", args.get("out"));
   io.addOutput("--covariance", args.get("covariance"));
+  io.addOutput("--track-covariance", args.get("track-covariance"));
   io.addOutput("--out-optimized", args.get("out-optimized"));
   io.addOutput("--stats", args.get("stats"));
   io.addOutput("--profile", profile_path);
@@ -220,6 +223,7 @@ int runRun(int argc, char** argv) {
   RunOutputOptions output_options;
   output_options.trajectory_path = args.get("out");
   output_options.covariance_path = args.get("covariance");
+  output_options.track_covariance_path = args.get("track-covariance");
   output_options.optimized_path = args.get("out-optimized");
   output_options.rss_every = rss_every;
   output_options.report_every = report_every;

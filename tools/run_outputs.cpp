@@ -55,6 +55,9 @@ Status RunOutputs::open() {
   }
   if (!options_.trajectory_path.empty()) PLUMB_RETURN_IF_ERROR(trajectory_writer_.open(options_.trajectory_path));
   if (!options_.covariance_path.empty()) PLUMB_RETURN_IF_ERROR(covariance_writer_.open(options_.covariance_path));
+  if (!options_.track_covariance_path.empty()) {
+    PLUMB_RETURN_IF_ERROR(track_covariance_writer_.open(options_.track_covariance_path, CovarianceFileKind::kTracked));
+  }
   if (!options_.mavlink.endpoint.empty()) {
     mavlink_ = std::make_unique<MavlinkOdometrySink>();
     PLUMB_RETURN_IF_ERROR(mavlink_->open(options_.mavlink).withContext("--mavlink"));
@@ -73,6 +76,8 @@ void RunOutputs::onPose(const FrameOutput& out) {
   sample.tracking_quality = out.state == TrackingState::kOk ? 100 : out.state == TrackingState::kWeak ? 50 : 0;
   sample.has_covariance = out.has_pose && out.track.covariance_valid;
   sample.covariance = out.track.covariance;
+  sample.has_local_covariance = out.has_pose && out.track.covariance_local_valid;
+  sample.local_covariance = out.track.covariance_local;
   // The estimate jumps at a new map segment and at a relocalization: the autopilot must know.
   sample.reset = out.new_map || out.relocalized;
   mavlink_->publish(sample);
@@ -81,6 +86,7 @@ void RunOutputs::onPose(const FrameOutput& out) {
 Status RunOutputs::close() {
   if (!options_.trajectory_path.empty()) PLUMB_RETURN_IF_ERROR(trajectory_writer_.close());
   if (!options_.covariance_path.empty()) PLUMB_RETURN_IF_ERROR(covariance_writer_.close());
+  if (!options_.track_covariance_path.empty()) PLUMB_RETURN_IF_ERROR(track_covariance_writer_.close());
   return Status::Ok();
 }
 
@@ -109,6 +115,15 @@ Status RunOutputs::onFrame(const FrameOutput& out) {
   }
   keyframes_ += out.keyframe;
   lost_ += !out.has_pose;
+  if (!options_.track_covariance_path.empty() && out.has_pose) {
+    StampedTrackedCovariance c;
+    c.timestamp = out.timestamp_s;
+    c.valid = out.track.covariance_valid && out.track.covariance_local_valid;
+    c.T_world_cam = out.T_world_cam;
+    c.covariance = out.track.covariance;
+    c.covariance_local = out.track.covariance_local;
+    PLUMB_RETURN_IF_ERROR(track_covariance_writer_.append(c));
+  }
   const uint64_t frame = statistics_.frames();
   if (options_.trace) {
     const Eigen::Vector3d t = out.T_world_cam.translation();
@@ -179,6 +194,10 @@ Status RunOutputs::onRetiredKeyframe(const RetiredKeyframe& kf) {
   c.timestamp = kf.timestamp_s;
   c.valid = kf.covariance_valid;
   c.covariance = kf.covariance;
+  c.has_relative = kf.uncertainty.hasRelative();
+  c.previous_timestamp = kf.uncertainty.previous_timestamp_s;
+  c.T_previous_this = kf.uncertainty.T_previous_this;
+  c.relative_covariance = kf.uncertainty.relative_covariance;
   return covariance_writer_.append(c);
 }
 

@@ -142,7 +142,10 @@ void LocalMapper::runLocalBa(int kf_slot, InsertResult* result) {
   ++stats_.ba_runs;
   result->ba_initial_cost = summary.initial_cost;
   result->ba_final_cost = summary.final_cost;
-  if (!summary.ok()) return;
+  if (!summary.ok()) {
+    writeUncertainty(kf_slot, false);
+    return;
+  }
 
   // Write back poses, landmarks, covariances.
   const bool have_covariance = ba_.computeCovariance(ba_options_);
@@ -155,6 +158,7 @@ void LocalMapper::runLocalBa(int kf_slot, InsertResult* result) {
       kf.covariance_valid = true;
     }
   }
+  writeUncertainty(kf_slot, have_covariance);
   for (uint32_t p : s_->ba_points) map_.point(int(p)).P_world = ba_.landmark(s_->point_ba_index[p]);
   for (uint32_t l : s_->ba_lines) {
     MapLine& line = map_.line(int(l));

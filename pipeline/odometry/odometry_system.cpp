@@ -29,6 +29,8 @@ Status validate(const SystemOptions& options) {
                          ") exceeds line_samples (" + std::to_string(options.odometry.extractor.line_samples) +
                          "): no line could ever be fitted");
   }
+  const std::string uncertainty = validate(options.odometry.uncertainty);
+  if (!uncertainty.empty()) return Status::Error("uncertainty options: " + uncertainty);
   if (options.output_delay_frames < 0 || options.output_delay_frames >= OdometryTrajectory::kMaxDelayFrames) {
     return Status::Error("output delay must be within 0.." + std::to_string(OdometryTrajectory::kMaxDelayFrames - 1) +
                          " frames");
