@@ -104,7 +104,7 @@ class LocalMapper {
   // local_mapper_covariance.cpp: after a BA's covariance, every window keyframe's relative pose
   // and covariance to its previous keyframe (when that BA held both); the new keyframe's world
   // covariance chained from its previous keyframe's.
-  void writeUncertainty(int kf_slot, bool have_covariance);
+  void writeUncertainty(int kf_slot, bool have_covariance, double variance_factor);
   int previousKeyframeSlot(uint32_t id) const;
   // local_mapper_snapshot.cpp
   void publishSnapshot(int kf_slot);

@@ -143,22 +143,26 @@ void LocalMapper::runLocalBa(int kf_slot, InsertResult* result) {
   result->ba_initial_cost = summary.initial_cost;
   result->ba_final_cost = summary.final_cost;
   if (!summary.ok()) {
-    writeUncertainty(kf_slot, false);
+    writeUncertainty(kf_slot, false, 1.0);
     return;
   }
 
   // Write back poses, landmarks, covariances.
+  const double variance_factor = ba_.varianceFactor(ba_options_);  // before: the covariance re-evaluates chi2
   const bool have_covariance = ba_.computeCovariance(ba_options_);
   for (int slot : window) {
     Keyframe& kf = map_.keyframe(slot);
     const int index = s_->ba_keyframe_index[slot];
     kf.T_world_cam = ba_.pose(index).inverse();
     if (have_covariance) {
-      kf.covariance = ba_.covariance(index);
+      // Calibrated like the relative covariances (docs/UNCERTAINTY.md); its gauge is this BA's
+      // fixed keyframes.
+      const UncertaintyOptions& u = options_.uncertainty;
+      kf.covariance = (u.use_variance_factor ? variance_factor : 1.0) * u.relative_scale * ba_.covariance(index);
       kf.covariance_valid = true;
     }
   }
-  writeUncertainty(kf_slot, have_covariance);
+  writeUncertainty(kf_slot, have_covariance, variance_factor);
   for (uint32_t p : s_->ba_points) map_.point(int(p)).P_world = ba_.landmark(s_->point_ba_index[p]);
   for (uint32_t l : s_->ba_lines) {
     MapLine& line = map_.line(int(l));

@@ -16,7 +16,7 @@ int LocalMapper::previousKeyframeSlot(uint32_t id) const {
   return previous;
 }
 
-void LocalMapper::writeUncertainty(int kf_slot, bool have_covariance) {
+void LocalMapper::writeUncertainty(int kf_slot, bool have_covariance, double variance_factor) {
   const UncertaintyOptions& u = options_.uncertainty;
   const double readout_s = camera_.rolling_shutter_readout_s;
   // Joint marginal blocks of a BA keyframe (zero for fixed ones: they are the gauge).
@@ -31,7 +31,6 @@ void LocalMapper::writeUncertainty(int kf_slot, bool have_covariance) {
   // of one keyframe displaces its own stamped pose, not the map the next ones are tracked in.
   Matrix6d chain_relative = defaultRelativeCovariance(u);
   if (have_covariance) {
-    const double variance_factor = ba_.varianceFactor(ba_options_);
     for (int slot : s_->window) {
       const int previous = previousKeyframeSlot(map_.keyframe(slot).id);
       if (previous < 0) continue;

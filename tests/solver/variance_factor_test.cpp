@@ -37,7 +37,9 @@ TEST(VarianceFactor, RecoversTheScaleOfTruncatedChiSquareSums) {
     }
     EXPECT_NEAR(varianceFactor(sums, 0.0, thresholds), s, 0.1 * s) << "s " << s;
     // Ignoring the truncation would be off by far more at s = 2.5 (the test can tell).
-    if (s > 2) EXPECT_LT((sums.chi2[0] + sums.chi2[1] + sums.chi2[2]) / sums.errorDof(), 0.8 * s);
+    if (s > 2) {
+      EXPECT_LT((sums.chi2[0] + sums.chi2[1] + sums.chi2[2]) / sums.errorDof(), 0.8 * s);
+    }
   }
   InlierChi2Sums few;
   few.add(3, 100.0);
