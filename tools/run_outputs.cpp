@@ -9,6 +9,7 @@
 
 #include "drivers/common/source_capture.h"
 #include "pipeline/odometry/odometry_trajectory.h"
+#include "pipeline/odometry/published_covariance.h"
 
 namespace plumb::tools {
 
@@ -116,13 +117,7 @@ Status RunOutputs::onFrame(const FrameOutput& out) {
   keyframes_ += out.keyframe;
   lost_ += !out.has_pose;
   if (!options_.track_covariance_path.empty() && out.has_pose) {
-    StampedTrackedCovariance c;
-    c.timestamp = out.timestamp_s;
-    c.valid = out.track.covariance_valid && out.track.covariance_local_valid;
-    c.T_world_cam = out.T_world_cam;
-    c.covariance = out.track.covariance;
-    c.covariance_local = out.track.covariance_local;
-    PLUMB_RETURN_IF_ERROR(track_covariance_writer_.append(c));
+    PLUMB_RETURN_IF_ERROR(track_covariance_writer_.append(toStampedTrackedCovariance(out)));
   }
   const uint64_t frame = statistics_.frames();
   if (options_.trace) {
@@ -190,15 +185,7 @@ Status RunOutputs::writeOptimized(const LoopRunResult& loop) {
 
 Status RunOutputs::onRetiredKeyframe(const RetiredKeyframe& kf) {
   if (options_.covariance_path.empty()) return Status::Ok();
-  StampedCovariance c;
-  c.timestamp = kf.timestamp_s;
-  c.valid = kf.covariance_valid;
-  c.covariance = kf.covariance;
-  c.has_relative = kf.uncertainty.hasRelative();
-  c.previous_timestamp = kf.uncertainty.previous_timestamp_s;
-  c.T_previous_this = kf.uncertainty.T_previous_this;
-  c.relative_covariance = kf.uncertainty.relative_covariance;
-  return covariance_writer_.append(c);
+  return covariance_writer_.append(toStampedCovariance(kf));
 }
 
 Status runToOutputs(FrameSource& source, const SystemOptions& system_options, const OdometryRunOptions& run_options,

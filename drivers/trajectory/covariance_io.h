@@ -30,27 +30,9 @@
 
 #include "drivers/common/atomic_file.h"
 #include "platform/status.h"
+#include "sensor/stamped_covariance.h"
 
 namespace plumb {
-
-struct StampedCovariance {
-  double timestamp = 0;
-  bool valid = false;
-  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
-  // Optional relative pose to the previous keyframe (valid only with `valid`).
-  bool has_relative = false;
-  double previous_timestamp = 0;
-  Eigen::Isometry3d T_previous_this = Eigen::Isometry3d::Identity();
-  Eigen::Matrix<double, 6, 6> relative_covariance = Eigen::Matrix<double, 6, 6>::Zero();
-};
-
-struct StampedTrackedCovariance {
-  double timestamp = 0;
-  bool valid = false;  // false: `# <t> no covariance`
-  Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
-  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
-  Eigen::Matrix<double, 6, 6> covariance_local = Eigen::Matrix<double, 6, 6>::Zero();
-};
 
 enum class CovarianceFileKind { kKeyframe, kTracked };
 

@@ -30,20 +30,29 @@ Eigen::Matrix<double, 6, 6> diagonalPoseCovariance(double sigma_translation_m, d
   return d.asDiagonal();
 }
 
+namespace {
+
+Eigen::Matrix<double, 6, 6> inflate(const UncertaintyOptions& o, double scale, double floor_translation_m,
+                                    double floor_rotation_rad, const Eigen::Matrix<double, 6, 6>& covariance,
+                                    double variance_factor) {
+  const double s = (o.use_variance_factor ? variance_factor : 1.0) * scale;
+  return s * covariance + diagonalPoseCovariance(floor_translation_m, floor_rotation_rad);
+}
+
+}  // namespace
+
 Eigen::Matrix<double, 6, 6> inflateRelativeCovariance(const UncertaintyOptions& o,
                                                       const Eigen::Matrix<double, 6, 6>& ba_relative,
                                                       double variance_factor) {
-  const double s = o.use_variance_factor ? variance_factor : 1.0;
-  return s * o.relative_scale * ba_relative +
-         diagonalPoseCovariance(o.relative_floor_translation_m, o.relative_floor_rotation_rad);
+  return inflate(o, o.relative_scale, o.relative_floor_translation_m, o.relative_floor_rotation_rad, ba_relative,
+                 variance_factor);
 }
 
 Eigen::Matrix<double, 6, 6> inflateTrackedCovariance(const UncertaintyOptions& o,
                                                      const Eigen::Matrix<double, 6, 6>& pose_only,
                                                      double variance_factor) {
-  const double s = o.use_variance_factor ? variance_factor : 1.0;
-  return s * o.tracked_scale * pose_only +
-         diagonalPoseCovariance(o.tracked_floor_translation_m, o.tracked_floor_rotation_rad);
+  return inflate(o, o.tracked_scale, o.tracked_floor_translation_m, o.tracked_floor_rotation_rad, pose_only,
+                 variance_factor);
 }
 
 Eigen::Matrix<double, 6, 6> timingCovariance(const UncertaintyOptions& o, double readout_s,

@@ -12,6 +12,7 @@
 #include "drivers/trajectory/evaluate.h"
 #include "drivers/trajectory/evaluate_nees.h"
 #include "pipeline/odometry/odometry_trajectory.h"
+#include "pipeline/odometry/published_covariance.h"
 #include "pipeline/run/odometry_run.h"
 
 namespace plumb::test {
@@ -21,13 +22,7 @@ class CovarianceCollectingSink final : public OdometrySink {
  public:
   Status onFrame(const FrameOutput& out) override {
     if (out.dropped || !out.has_pose) return Status::Ok();
-    StampedTrackedCovariance c;
-    c.timestamp = out.timestamp_s;
-    c.valid = out.track.covariance_valid && out.track.covariance_local_valid;
-    c.T_world_cam = out.T_world_cam;
-    c.covariance = out.track.covariance;
-    c.covariance_local = out.track.covariance_local;
-    file.frames.push_back(c);
+    file.frames.push_back(toStampedTrackedCovariance(out));
     return Status::Ok();
   }
   Status onFinishedFrame(const FinishedFrame& f) override {
@@ -35,15 +30,7 @@ class CovarianceCollectingSink final : public OdometrySink {
     return Status::Ok();
   }
   Status onRetiredKeyframe(const RetiredKeyframe& kf) override {
-    StampedCovariance c;
-    c.timestamp = kf.timestamp_s;
-    c.valid = kf.covariance_valid;
-    c.covariance = kf.covariance;
-    c.has_relative = kf.uncertainty.hasRelative();
-    c.previous_timestamp = kf.uncertainty.previous_timestamp_s;
-    c.T_previous_this = kf.uncertainty.T_previous_this;
-    c.relative_covariance = kf.uncertainty.relative_covariance;
-    file.keyframes.push_back(c);
+    file.keyframes.push_back(toStampedCovariance(kf));
     return Status::Ok();
   }
   CovarianceFile file;
