@@ -10,6 +10,7 @@
 #include "tools/args.h"
 #include "tools/command.h"
 #include "tools/eval_nees.h"
+#include "tools/io_plan.h"
 
 namespace plumb::tools {
 namespace {
@@ -89,6 +90,19 @@ int runEval(int argc, char** argv) {
     return 2;
   }
   const std::string gt_path = args.get("gt"), est_path = args.get("est"), plot_path = args.get("plot");
+  // The plot never overwrites an input (the ground truth, the estimate, a link to either), and
+  // its folder must take it: checked before anything is read.
+  IoPlan io;
+  io.addInput(gt_path);
+  io.addInput(est_path);
+  io.addInput(args.get("covariance"));
+  io.addInput(args.get("track-covariance"));
+  io.addOutput("--plot", plot_path);
+  const Status io_status = io.check();
+  if (!io_status.ok()) {
+    std::fprintf(stderr, "plumb eval: %s\n", io_status.message().c_str());
+    return 2;
+  }
   std::vector<StampedPose> ground_truth, estimate;
   TrajectoryReadReport gt_report, est_report;
   for (const Status& st : {readTrajectory("ground truth", gt_path, &ground_truth, &gt_report),

@@ -47,6 +47,7 @@ class CovarianceWriter {
   Status append(const StampedCovariance& keyframe);         // allocates nothing
   Status append(const StampedTrackedCovariance& frame);     // allocates nothing
   Status close();
+  void abandon() { file_.abandon(); }  // nothing appears under the name (an older file stays)
 
  private:
   std::string path_;
