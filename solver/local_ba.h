@@ -166,6 +166,11 @@ class LocalBundleAdjuster {
   double observationChi2(int observation) const { return observations_[observation].chi2; }
   bool isOutlier(int observation) const { return observations_[observation].outlier; }
   double cost(const LocalBaOptions& options) const;  // robust cost at the current estimate
+  // A posteriori variance factor sigma0^2 (solver/variance_factor.h) of the inliers after solve():
+  // redundancy = inlier error dof - 6 per optimised pose - per landmark min(its inlier error dof,
+  // 3 for a point, 2 for a line sample: its slide along the line is unobservable).
+  // Read it before computeCovariance(), which re-evaluates the chi2 values. local_ba_variance.cpp.
+  double varianceFactor(const LocalBaOptions& options) const;
 
   // Diagnostics (tests): linearise at the current estimate and solve ONE damped step with the
   // given lambda, without applying it. Returns false if the damped S is not positive definite.

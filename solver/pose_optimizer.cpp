@@ -124,6 +124,7 @@ int classify(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_cam_worl
               PoseResult* result) {
   result->num_point_inliers = 0;
   result->num_line_inliers = 0;
+  result->inlier_chi2 = InlierChi2Sums{};
   int changed = 0;
   double chi2 = 0.0;
   for (int i = 0; i < num_points; ++i) {
@@ -132,12 +133,14 @@ int classify(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_cam_worl
     changed += inlier != point_inliers[i] ? 1 : 0;
     point_inliers[i] = inlier;
     result->num_point_inliers += inlier ? 1 : 0;
+    if (inlier) result->inlier_chi2.add(points[i].has_depth ? 3 : 2, chi2);
   }
   for (int i = 0; i < num_lines; ++i) {
     const bool inlier = lineChi2(camera, T_cam_world, lines[i], &chi2) && chi2 <= options.chi2.line;
     changed += inlier != line_inliers[i] ? 1 : 0;
     line_inliers[i] = inlier;
     result->num_line_inliers += inlier ? 1 : 0;
+    if (inlier) result->inlier_chi2.add(1, chi2);
   }
   return changed;
 }

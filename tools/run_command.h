@@ -41,6 +41,7 @@ struct RunCommandOptions {
   bool discard_trajectory = false;  // --discard-trajectory
   std::string out_optimized;        // --out-optimized FILE
   std::string covariance;           // --covariance FILE
+  std::string track_covariance;     // --track-covariance FILE
   std::string stats;                // --stats FILE
   std::string save_map;             // --save-map FILE
   std::string mavlink;              // --mavlink ENDPOINT

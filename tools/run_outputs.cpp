@@ -11,6 +11,7 @@
 
 #include "drivers/common/source_capture.h"
 #include "pipeline/odometry/odometry_trajectory.h"
+#include "pipeline/odometry/published_covariance.h"
 
 namespace plumb::tools {
 
@@ -57,6 +58,9 @@ Status RunOutputs::begin(const OdometrySystem&) {
   }
   if (!options_.trajectory_path.empty()) PLUMB_RETURN_IF_ERROR(trajectory_writer_.open(options_.trajectory_path));
   if (!options_.covariance_path.empty()) PLUMB_RETURN_IF_ERROR(covariance_writer_.open(options_.covariance_path));
+  if (!options_.track_covariance_path.empty()) {
+    PLUMB_RETURN_IF_ERROR(track_covariance_writer_.open(options_.track_covariance_path, CovarianceFileKind::kTracked));
+  }
   if (!options_.mavlink.endpoint.empty()) {
     mavlink_ = std::make_unique<MavlinkOdometrySink>();
     PLUMB_RETURN_IF_ERROR(mavlink_->open(options_.mavlink).withContext("--mavlink"));
@@ -76,6 +80,8 @@ void RunOutputs::onPose(const FrameOutput& out) {
   sample.tracking_quality = out.state == TrackingState::kOk ? 100 : out.state == TrackingState::kWeak ? 50 : 0;
   sample.has_covariance = out.has_pose && out.track.covariance_valid;
   sample.covariance = out.track.covariance;
+  sample.has_local_covariance = out.has_pose && out.track.covariance_local_valid;
+  sample.local_covariance = out.track.covariance_local;
   // The estimate jumps at a new map segment and at a relocalization: the autopilot must know.
   sample.reset = out.new_map || out.relocalized;
   mavlink_->publish(sample);
@@ -87,12 +93,14 @@ Status RunOutputs::close(bool keep) {
   if (!keep) {
     trajectory_writer_.abandon();
     covariance_writer_.abandon();
+    track_covariance_writer_.abandon();
     if (frames_stream_ != nullptr) std::fclose(frames_stream_);
     frames_stream_ = nullptr;
     return Status::Ok();
   }
   if (!options_.trajectory_path.empty()) PLUMB_RETURN_IF_ERROR(trajectory_writer_.close());
   if (!options_.covariance_path.empty()) PLUMB_RETURN_IF_ERROR(covariance_writer_.close());
+  if (!options_.track_covariance_path.empty()) PLUMB_RETURN_IF_ERROR(track_covariance_writer_.close());
   return Status::Ok();
 }
 
@@ -155,6 +163,9 @@ Status RunOutputs::onFrame(const FrameOutput& out) {
   }
   keyframes_ += out.keyframe;
   lost_ += !out.has_pose;
+  if (!options_.track_covariance_path.empty() && out.has_pose) {
+    PLUMB_RETURN_IF_ERROR(track_covariance_writer_.append(toStampedTrackedCovariance(out)));
+  }
   const uint64_t frame = statistics_.frames();
   if (options_.trace) {
     const Eigen::Vector3d t = out.T_world_cam.translation();
@@ -218,11 +229,7 @@ Status RunOutputs::writeOptimized(const LoopRunResult& loop) {
 
 Status RunOutputs::onRetiredKeyframe(const RetiredKeyframe& kf) {
   if (options_.covariance_path.empty()) return Status::Ok();
-  StampedCovariance c;
-  c.timestamp = kf.timestamp_s;
-  c.valid = kf.covariance_valid;
-  c.covariance = kf.covariance;
-  return covariance_writer_.append(c);
+  return covariance_writer_.append(toStampedCovariance(kf));
 }
 
 Status runToOutputs(FrameSource& source, const SystemOptions& system_options, const OdometryRunOptions& run_options,

@@ -20,6 +20,7 @@ namespace plumb::tools {
 struct RunOutputOptions {
   std::string trajectory_path;  // TUM file, one line per input frame ('' = none)
   std::string covariance_path;  // one line per keyframe ('' = none)
+  std::string track_covariance_path;  // one line per tracked frame ('' = none)
   // The optimised trajectory (docs/LOOP.md): every frame through its reference keyframe's pose in
   // the final pose graph, written at the end of the run ('' = none).
   std::string optimized_path;
@@ -53,7 +54,10 @@ class RunOutputs final : public OdometrySink {
   // nothing valid, e.g. it failed before its first frame; an older file of that name stays).
   // Nothing when they were never opened.
   Status close(bool keep = true);
-  bool anyFile() const { return !options_.trajectory_path.empty() || !options_.covariance_path.empty() || !options_.optimized_path.empty(); }
+  bool anyFile() const {
+    return !options_.trajectory_path.empty() || !options_.covariance_path.empty() ||
+           !options_.track_covariance_path.empty() || !options_.optimized_path.empty();
+  }
   void endProgress();  // ends the terminal's progress line
 
   void onPose(const FrameOutput& frame) override;
@@ -80,6 +84,7 @@ class RunOutputs final : public OdometrySink {
   bool opened_ = false;
   TumTrajectoryWriter trajectory_writer_;
   CovarianceWriter covariance_writer_;
+  CovarianceWriter track_covariance_writer_;
   std::vector<StampedPose> trajectory_;
   // --out-optimized: one fixed-size record per finished frame in an anonymous temporary file
   // (std::tmpfile: removed by the OS however the process ends), so memory stays flat.

@@ -67,6 +67,7 @@ Status checkFiles(const RunCommandOptions& o) {
   io.addOutput("--save-map", o.save_map);
   io.addOutput("--out", o.out);
   io.addOutput("--covariance", o.covariance);
+  io.addOutput("--track-covariance", o.track_covariance);
   io.addOutput("--out-optimized", o.out_optimized);
   io.addOutput("--stats", o.stats);
   io.addOutput("--profile", o.profile);
@@ -120,6 +121,7 @@ Status planRun(const RunCommandOptions& o, const std::atomic<bool>* stop, RunPla
   RunOutputOptions& out = plan->output_options;
   out.trajectory_path = o.out;
   out.covariance_path = o.covariance;
+  out.track_covariance_path = o.track_covariance;
   out.optimized_path = o.out_optimized;
   out.rss_every = long(o.rss_every);
   out.report_every = long(o.report_every);

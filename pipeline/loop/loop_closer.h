@@ -4,7 +4,8 @@
 //
 // addKeyframe(record), for each keyframe the mapping side inserted, in id order:
 //   1. graph: a node for the keyframe, linked to the previous node by an odometry edge
-//      T_previous_this weighted by the local-BA marginal covariance (+ a floor), or by a default
+//      T_previous_this weighted by its calibrated covariance from local BA's joint marginal (+ a
+//      floor; docs/UNCERTAINTY.md), or by a default
 //      information when BA gave none; a new map segment is linked by a weak edge.
 //   2. detection: KeyframeDatabase query, candidates older than min_age_keyframes (outside the
 //      local window); a candidate must be consistent over min_consistent consecutive queries

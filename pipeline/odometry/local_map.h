@@ -49,6 +49,10 @@ struct LocalMap {
   uint32_t reference_keyframe_id = 0;
   uint64_t reference_keyframe_sequence = 0;
   Eigen::Isometry3d T_world_reference = Eigen::Isometry3d::Identity();
+  // The reference keyframe's world covariance (KeyframeUncertainty), what the tracked pose's
+  // published covariance builds on; invalid: the tracked pose gets none.
+  Eigen::Matrix<double, 6, 6> reference_world_covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  bool reference_world_covariance_valid = false;
   int reference_tracked_landmarks = 0;  // landmarks of the reference KF observed by >= 2 keyframes
   int keyframes_in_map = 0;
   FixedVector<LocalMapKeyframe, kMaxMapKeyframes> keyframes;  // every keyframe in the map, by id
@@ -58,6 +62,7 @@ struct LocalMap {
   void clear() {
     version = 0;
     reference_keyframe_id = 0;
+    reference_world_covariance_valid = false;
     reference_tracked_landmarks = 0;
     keyframes_in_map = 0;
     keyframes.clear();

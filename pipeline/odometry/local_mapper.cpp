@@ -36,6 +36,7 @@ void LocalMapper::retireKeyframe(int kf_slot) {
   r.T_world_cam = kf.T_world_cam;
   r.covariance = kf.covariance;
   r.covariance_valid = kf.covariance_valid;
+  r.uncertainty = kf.uncertainty;
   // retired_ is drained by the caller after every insertion; when it is not, the oldest report
   // is the one dropped (the output is a courtesy, the map must stay bounded).
   if (retired_.full()) {
@@ -67,9 +68,19 @@ InsertResult LocalMapper::insertKeyframe(const KeyframeRequest& request) {
   kf.frame_sequence = request.frame_sequence;
   kf.timestamp_s = request.timestamp_s;
   kf.T_world_cam = request.T_world_cam;
+  kf.uncertainty.twist_per_s = request.twist_per_s;
   // Tracked against a snapshot from before the last loop correction: move it with the map.
   if (!request.start_new_map && request.local_map_version < correction_version_) {
     kf.T_world_cam = last_correction_ * request.T_world_cam;
+  }
+  if (request.start_new_map) {
+    // The world frame is the first map's first keyframe (exact); a later segment starts at the
+    // last known pose, a guess (docs/UNCERTAINTY.md).
+    const UncertaintyOptions& u = options_.uncertainty;
+    kf.uncertainty.world_covariance =
+        segment_ <= 1 ? Eigen::Matrix<double, 6, 6>::Zero()
+                      : diagonalPoseCovariance(u.segment_translation_sigma_m, u.segment_rotation_sigma_rad);
+    kf.uncertainty.world_covariance_valid = true;
   }
   result.inserted = true;
   result.keyframe_id = kf.id;

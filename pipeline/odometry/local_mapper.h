@@ -33,6 +33,7 @@ struct RetiredKeyframe {
   Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
   bool covariance_valid = false;
+  KeyframeUncertainty uncertainty;
 };
 
 struct MapperStats {
@@ -102,6 +103,11 @@ class LocalMapper {
   void selectWindow(int kf_slot);
   void excludeSingleViewLandmarks();
   void moveSingleViewLandmarks();
+  // local_mapper_covariance.cpp: after a BA's covariance, every window keyframe's relative pose
+  // and covariance to its previous keyframe (when that BA held both); the new keyframe's world
+  // covariance chained from its previous keyframe's.
+  void writeUncertainty(int kf_slot, bool have_covariance, double variance_factor);
+  int previousKeyframeSlot(uint32_t id) const;
   // local_mapper_snapshot.cpp
   void publishSnapshot(int kf_slot);
   void rankCovisible(int kf_slot, int count, FixedVector<int, kMaxMapKeyframes>* out) const;

@@ -210,9 +210,13 @@ void LocalMapper::runLocalBa(int kf_slot, InsertResult* result) {
   ++stats_.ba_runs;
   result->ba_initial_cost = summary.initial_cost;
   result->ba_final_cost = summary.final_cost;
-  if (!summary.ok()) return;
+  if (!summary.ok()) {
+    writeUncertainty(kf_slot, false, 1.0);
+    return;
+  }
 
   // Write back poses, landmarks, covariances.
+  const double variance_factor = ba_.varianceFactor(ba_options_);  // before: the covariance re-evaluates chi2
   const bool have_covariance = ba_.computeCovariance(ba_options_);
   for (int slot : window) {
     Keyframe& kf = map_.keyframe(slot);
@@ -221,11 +225,15 @@ void LocalMapper::runLocalBa(int kf_slot, InsertResult* result) {
     s_->ba_correction[std::size_t(slot)] = T_world_cam * kf.T_world_cam.inverse();
     kf.T_world_cam = T_world_cam;
     if (have_covariance) {
-      kf.covariance = ba_.covariance(index);
+      // Calibrated like the relative covariances (docs/UNCERTAINTY.md); its gauge is this BA's
+      // fixed keyframes.
+      const UncertaintyOptions& u = options_.uncertainty;
+      kf.covariance = (u.use_variance_factor ? variance_factor : 1.0) * u.relative_scale * ba_.covariance(index);
       kf.covariance_valid = true;
     }
   }
   moveSingleViewLandmarks();
+  writeUncertainty(kf_slot, have_covariance, variance_factor);
   for (uint32_t p : s_->ba_points) map_.point(int(p)).P_world = ba_.landmark(s_->point_ba_index[p]);
   for (uint32_t l : s_->ba_lines) {
     MapLine& line = map_.line(int(l));

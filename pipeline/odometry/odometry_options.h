@@ -6,6 +6,7 @@
 #include "solver/outlier_thresholds.h"
 #include "pipeline/frontend/extractor_options.h"
 #include "pipeline/odometry/matcher.h"
+#include "pipeline/odometry/uncertainty_options.h"
 
 namespace plumb {
 
@@ -87,6 +88,7 @@ struct OdometryOptions {
   KeyframePolicyOptions keyframes;
   LocalMapperOptions mapper;
   RelocalizerOptions relocalizer;
+  UncertaintyOptions uncertainty;  // what the published covariances add (docs/UNCERTAINTY.md)
   // A map starts from a frame with this many keypoints with depth, or half of it plus lines.
   int min_initial_points = 100;
   int min_initial_lines = 10;

@@ -32,6 +32,8 @@ Status validate(const SystemOptions& options) {
   if (options.map_lag_frames < 1 || options.map_lag_frames > SystemOptions::kMaxMapLagFrames) {
     return Status::Error("map lag must be within 1.." + std::to_string(SystemOptions::kMaxMapLagFrames) + " frames");
   }
+  const std::string uncertainty = validate(options.odometry.uncertainty);
+  if (!uncertainty.empty()) return Status::Error("uncertainty options: " + uncertainty);
   if (options.output_delay_frames < 0 || options.output_delay_frames >= OdometryTrajectory::kMaxDelayFrames) {
     return Status::Error("output delay must be within 0.." + std::to_string(OdometryTrajectory::kMaxDelayFrames - 1) +
                          " frames");

@@ -133,11 +133,10 @@ TrackResult Tracker::track(const FrameFeatures& input, uint64_t sequence, double
 
   // 3. Local map: more matches, optimise again with everything.
   result.local_map_matches = matchLocalMap(frame, T_cam_world);
+  PoseResult final_pose;
   if (result.frame_matches + result.local_map_matches >= 6) {
-    const PoseResult pose = optimizeAndPrune(frame, T_cam_world, &result);
-    T_cam_world = pose.T_cam_world;
-    result.covariance = pose.covariance;
-    result.covariance_valid = pose.covariance_valid;
+    final_pose = optimizeAndPrune(frame, T_cam_world, &result);
+    T_cam_world = final_pose.T_cam_world;
   }
   const int inliers = result.point_inliers + result.line_inliers;
   if (inliers >= options_.tracker.min_inliers_ok) {
@@ -169,9 +168,12 @@ TrackResult Tracker::track(const FrameFeatures& input, uint64_t sequence, double
   velocity_cur_last_ = T_cam_world * T_world_last_;
   velocity_dt_s_ = timestamp_s - last_timestamp_s_;
   has_velocity_ = true;
+  const Vector6d twist_per_s = velocity_dt_s_ > 0 ? Vector6d(logSE3(velocity_cur_last_) / velocity_dt_s_) : Vector6d::Zero();
+  publishCovariance(final_pose, twist_per_s, &result);
   ++frames_since_keyframe_;
   if (request != nullptr && keyframeNeeded(frame, result)) {
     fillKeyframeRequest(frame, sequence, timestamp_s, T_world_cam, request);
+    request->twist_per_s = twist_per_s;
     result.keyframe_requested = true;
     frames_since_keyframe_ = 0;
   }
@@ -248,6 +250,7 @@ void Tracker::fillNewMapRequest(const FrameFeatures& frame, uint64_t sequence, d
   request->start_new_map = true;
   request->frame_sequence = sequence;
   request->timestamp_s = timestamp_s;
+  request->twist_per_s.setZero();
   request->T_world_cam = T_world_cam;
   request->local_map_version = 0;
   request->features = frame;

@@ -97,6 +97,9 @@ class Tracker {
   // tracker_pose.cpp: optimise from T_cam_world, drop outlier associations, count inliers.
   PoseResult optimizeAndPrune(const FrameFeatures& frame, const Eigen::Isometry3d& T_cam_world,
                               TrackResult* result);
+  // The tracked pose's published covariances (TrackResult) from the final optimisation.
+  // twist_per_s: the frame's velocity (timing model error, UncertaintyOptions).
+  void publishCovariance(const PoseResult& pose, const Vector6d& twist_per_s, TrackResult* result) const;
   // tracker.cpp
   void rememberLastFrame(const FrameFeatures& frame, const Eigen::Isometry3d& T_world_cam);
   // tracker_last_frame.cpp: the setLocalMap update of the last frame described above.
