@@ -140,6 +140,11 @@ Status runOdometry(FrameCapture& capture, OdometrySystem& system, OdometrySink& 
     r.corrections_published = loop->correctionsPublished();
     r.capacity = loop->closer().capacity();
     r.memory_bytes = loop->closer().memoryBytes();
+    const loop::LoopAudit& audit = loop->closer().audit();
+    r.audit = audit.entries();
+    r.audit_keyframes = audit.keyframes();
+    r.audit_entries_dropped = audit.entriesDropped();
+    r.audit_keyframes_dropped = audit.keyframesDropped();
     r.keyframes.clear();
     r.keyframes.reserve(loop->closer().size());
     for (std::size_t i = 0; i < loop->closer().size(); ++i) {

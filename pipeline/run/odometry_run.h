@@ -110,6 +110,11 @@ struct LoopRunResult {
   // Every keyframe of the final graph (id ascending) with its optimised pose: the optimised
   // trajectory re-expresses each frame through its reference keyframe's pose here.
   std::vector<std::pair<uint32_t, Eigen::Isometry3d>> keyframes;
+  // The loop audit (pipeline/loop/loop_audit.h), copied at the end of the run.
+  std::vector<loop::LoopAuditEntry> audit;
+  std::vector<loop::LoopAuditKeyframe> audit_keyframes;
+  uint64_t audit_entries_dropped = 0;
+  uint64_t audit_keyframes_dropped = 0;
   // The pose of `id` in the final graph; false when it is not there (culled, or never received).
   bool keyframePose(uint32_t id, Eigen::Isometry3d* T_world_cam) const;
 };
