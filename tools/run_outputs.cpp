@@ -73,8 +73,9 @@ void RunOutputs::onPose(const FrameOutput& out) {
   sample.tracking_quality = out.state == TrackingState::kOk ? 100 : out.state == TrackingState::kWeak ? 50 : 0;
   sample.has_covariance = out.has_pose && out.track.covariance_valid;
   sample.covariance = out.track.covariance;
-  // The estimate jumps at a new map segment and at a relocalization: the autopilot must know.
-  sample.reset = out.new_map || out.relocalized;
+  // The estimate jumps at a new map segment, a relocalization and a loop correction: the
+  // autopilot must know (docs/LOOP.md "What the robot receives").
+  sample.reset = out.new_map || out.relocalized || out.loop_corrected;
   mavlink_->publish(sample);
 }
 

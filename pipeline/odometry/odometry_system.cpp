@@ -182,6 +182,12 @@ void OdometrySystem::trackFeatures(const FrameFeatures& features, uint64_t seque
   }
   if (!request_pending) tracking_.frames_since_request = 0;
   installNewestSnapshot();
+  const LocalMap& installed = tracking_.tracker->localMap();
+  if (installed.loop_corrections != tracking_.loop_corrections_seen) {
+    // A new segment restarts the count at 0 (and is announced as a new map); only an increase is a jump.
+    tracking_.loop_correction_unannounced |= installed.loop_corrections > tracking_.loop_corrections_seen;
+    tracking_.loop_corrections_seen = installed.loop_corrections;
+  }
   FrameOutput& o = out->output;
   o = FrameOutput{};
   o.sequence = sequence;
@@ -221,6 +227,10 @@ void OdometrySystem::trackFeatures(const FrameFeatures& features, uint64_t seque
   }
   if (!o.has_pose && tracking_.map_started) o.state = TrackingState::kLost;
   if (o.has_pose) tracking_.T_world_last_good = o.T_world_cam;
+  if (o.has_pose && tracking_.loop_correction_unannounced) {
+    o.loop_corrected = true;
+    tracking_.loop_correction_unannounced = false;
+  }
   o.track_ms = millisecondsSince(start);
 }
 
