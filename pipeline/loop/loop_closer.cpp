@@ -113,6 +113,16 @@ bool LoopCloser::pose(uint32_t keyframe_id, Eigen::Isometry3d* T_world_cam) cons
   return true;
 }
 
+bool LoopCloser::finalPose(uint32_t keyframe_id, Eigen::Isometry3d* T_world_cam, uint64_t* epoch) const {
+  const int p = findPosition(keyframe_id);
+  if (p < 0) return false;
+  const Node& n = nodes_[std::size_t(order_[std::size_t(p)])];
+  if (!n.has_final) return false;
+  *T_world_cam = n.T_world_final;
+  *epoch = n.final_epoch;
+  return true;
+}
+
 Matrix6d LoopCloser::edgeCovariance(bool new_segment, const Matrix6d& covariance,
                                     bool covariance_valid) const {
   if (new_segment)
@@ -334,9 +344,22 @@ void LoopCloser::optimise() {
       nodes_[std::size_t(order_[p])].T_world_cam = graph_.pose(int(p)).inverse();
     }
   }
+  // The real-time correction is anchored to the candidate as the robot had it (docs/LOOP.md "What
+  // the robot receives"): the query goes where the loop says it is relative to the candidate's
+  // pose when it was made (its record's; its final local-map pose may already carry corrections
+  // made while it was still in the local map), so a place the robot returns to gets the
+  // coordinates it had before. The graph's optimum (which moves the old side too, but not what
+  // was already output) is the optimised trajectory's.
   const Node& query = nodes_[std::size_t(order_.back())];
   correction_.keyframe_id = query.id;
   correction_.T_world_cam = query.T_world_cam;
+  if (!loop_edges_.empty() && loop_edges_.back().query_id == query.id) {
+    const int c = findPosition(loop_edges_.back().candidate_id);
+    if (c >= 0) {
+      const Node& candidate = nodes_[std::size_t(order_[std::size_t(c)])];
+      correction_.T_world_cam = candidate.T_world_record * loop_edges_.back().T_candidate_query;
+    }
+  }
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   ++stats_.optimisations;

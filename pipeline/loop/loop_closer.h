@@ -143,6 +143,9 @@ class LoopCloser {
 
   // The graph's current pose of a keyframe (optimised after a loop); false if not in the graph.
   bool pose(uint32_t keyframe_id, Eigen::Isometry3d* T_world_cam) const;
+  // Its final local-map pose and the loop epoch it was reported in (keyframeFinal); false if the
+  // keyframe is not in the graph or never left the local map.
+  bool finalPose(uint32_t keyframe_id, Eigen::Isometry3d* T_world_cam, uint64_t* epoch) const;
   std::size_t size() const { return order_.size(); }
   std::size_t capacity() const { return std::size_t(options_.capacity); }
   const LoopStats& stats() const { return stats_; }

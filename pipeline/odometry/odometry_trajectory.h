@@ -28,6 +28,9 @@ struct FinishedFrame {
   // closing's optimised trajectory re-expresses the frame through that keyframe's final pose.
   uint32_t reference_id = 0;
   Eigen::Isometry3d T_ref_cam = Eigen::Isometry3d::Identity();
+  // Loop corrections the mapping side had applied when the frame was finished: the world frame
+  // T_world_cam is in (each correction moves it). Set by OdometrySystem.
+  uint64_t loop_epoch = 0;
 };
 
 // The frame as a trajectory sample: what trajectory files, the tools and the API keep of it.
