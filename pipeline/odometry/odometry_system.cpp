@@ -285,6 +285,9 @@ const FrameOutput& OdometrySystem::mapFrame(const TrackedFrame& tracked) {
     }
   }
   recordOutput(tracked);
+  const LocalMap& world = mapping_.mapper->localMap();
+  mapping_.trajectory.setWorld(mapping_.stats.loop_corrections_applied, world.segment, world.loop_corrections,
+                               world.T_loop_corrections);
   mapping_.stats.output_overflows += !mapping_.trajectory.push(mapping_.output.sequence, mapping_.output.timestamp_s, mapping_.output.has_pose, mapping_.output.T_world_cam, reference_id,
                    T_ref_cam);
   return mapping_.output;

@@ -117,10 +117,7 @@ class OdometrySystem {
   // Frames whose output pose is final, oldest first; fn(const FinishedFrame&).
   template <typename Fn>
   void drainFinishedFrames(Fn fn) {
-    mapping_.trajectory.popReady(mapping_.mapper->localMap(), [&](FinishedFrame f) {
-      f.loop_epoch = mapping_.stats.loop_corrections_applied;
-      fn(f);
-    });
+    mapping_.trajectory.popReady(mapping_.mapper->localMap(), fn);
   }
   // Retired keyframes (final pose + covariance); fn(const RetiredKeyframe&).
   template <typename Fn>
@@ -131,10 +128,7 @@ class OdometrySystem {
   // End of the run: every pending frame is finished and every keyframe retired.
   template <typename FrameFn, typename KeyframeFn>
   void finish(FrameFn frame_fn, KeyframeFn keyframe_fn) {
-    mapping_.trajectory.flushAll(mapping_.mapper->localMap(), [&](FinishedFrame f) {
-      f.loop_epoch = mapping_.stats.loop_corrections_applied;
-      frame_fn(f);
-    });
+    mapping_.trajectory.flushAll(mapping_.mapper->localMap(), frame_fn);
     mapping_.mapper->retireAll();
     drainRetiredKeyframes(keyframe_fn);
   }
