@@ -138,15 +138,20 @@ def main():
     p.add_argument("--tum", default="head250,desk9", help="TUM folders to include (comma list, '' for none)")
     p.add_argument("--datasets", default="../shared/datasets")
     p.add_argument("--noloops-from", default="", help="reuse the --no-loops runs of another --work folder")
+    p.add_argument("--evaluate-only", action="store_true", help="run nothing: the table of the runs finished so far")
     args = p.parse_args()
     args.presets = [x for x in args.presets.split(",") if x]
     args.seeds = [int(x) for x in args.seeds.split(",") if x]
     args.tum = [x for x in args.tum.split(",") if x]
     os.makedirs(args.work, exist_ok=True)
     seqs = sequences(args)
-    with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-        for seq in pool.map(lambda s: do_runs(args, s), seqs):
-            print(f"done {seq.name}", file=sys.stderr)
+    if not args.evaluate_only:
+        with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+            for seq in pool.map(lambda s: do_runs(args, s), seqs):
+                print(f"done {seq.name}", file=sys.stderr)
+    if args.evaluate_only:  # only what finished
+        seqs = [s for s in seqs if os.path.exists(os.path.join(args.work, key(s)) + ".loops.done")
+                and os.path.exists(os.path.join(args.work, key(s)) + ".noloops.done")]
     rows = [evaluate(args, s) for s in seqs]
 
     print("| sequence | no loops ATE [m] | `--out` ATE [m] | `--out` / no loops | `--out-optimized` ATE [m] | "

@@ -86,7 +86,11 @@ std::size_t LoopCloser::memoryBytesFor(const LoopCloserOptions& o) {
   return sizeof(LoopCloser) + slots * (sizeof(LoopCandidate) + sizeof(Node) + 2 * sizeof(int)) +
          std::size_t(o.max_loop_edges) * sizeof(LoopEdge) +
          KeyframeDatabase::memoryBytesFor(databaseOptions(o)) + graph + sparse + sizeof(LoopVerifier) +
-         110 * 1024;  // verifier scratch (~105 KB)
+         110 * 1024 +  // verifier scratch (~105 KB)
+         slots * sizeof(Eigen::Isometry3d) +  // poses before an optimisation (rollback)
+         LoopContextCheck::scratchBytes() +
+         LoopAudit::kDefaultMaxEntries * sizeof(LoopAuditEntry) +
+         LoopAudit::kDefaultMaxKeyframes * sizeof(LoopAuditKeyframe);
 }
 
 std::size_t LoopCloser::memoryBytes() const { return memoryBytesFor(options_); }

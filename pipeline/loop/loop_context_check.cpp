@@ -16,6 +16,8 @@ LoopContextCheck::LoopContextCheck(const CameraIntrinsics& camera, const LoopCon
 
 LoopContextCheck::~LoopContextCheck() = default;
 
+std::size_t LoopContextCheck::scratchBytes() { return sizeof(Scratch); }
+
 LoopContextResult LoopContextCheck::evaluate(const LoopContextSide& query, const LoopContextSide& candidate) {
   LoopContextResult r;
   Scratch& s = *s_;

@@ -71,6 +71,7 @@ class LoopContextCheck {
     return !(r.cost_after > options_.max_cost_ratio * r.cost_before);
   }
   const LoopContextCheckOptions& options() const { return options_; }
+  static std::size_t scratchBytes();  // allocated by the constructor
 
  private:
   struct Scratch;

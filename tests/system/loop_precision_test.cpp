@@ -3,9 +3,9 @@
 // drivers/trajectory/loop_grading.h). A loop is correct within 5 cm, 2 deg and 3 sigma of its own
 // covariance.
 //   - office_loop, noise-free like a rendered dataset, shortened to two 8 s laps (480 frames):
-//     loops are found, all of them correct, and the optimised trajectory is no worse than the
-//     run without loop closing (ATE +2 %);
-//   - office_pass with Kinect-like noise, its first 420 frames (past three identical
+//     loops are found, all of them correct, the optimised trajectory is no worse than the run
+//     without loop closing (ATE +2 %), and every correction is announced once (reset_counter);
+//   - office_pass with Kinect-like noise, its first 300 frames (past two identical
 //     workstations, no revisit): no wrong loop.
 // ~15-25 s together on a quiet machine.
 #include <gtest/gtest.h>
@@ -47,6 +47,7 @@ GradedRun runAndGrade(const SynthOptions& options, bool loops = true) {
   out.gt = groundTruth(source->scene(), options.frames);
   RunSettings settings;
   settings.loop_closing = loops;
+  settings.keep_outputs = true;
   out.run = runOdometry(*source, systemOptions(true), settings);
   if (loops) out.grading = gradeLoops(out.gt, auditOf(out.run.result.loop), LoopGradingOptions{});
   return out;
@@ -77,12 +78,17 @@ TEST(LoopPrecision, RenderedOfficeWithRevisitsAcceptsOnlyCorrectLoops) {
   const double ate_optimised = ateRmse(with.gt, with.run.optimized);
   std::printf("ATE without loop closing %.4f m, optimised %.4f m\n", ate_without, ate_optimised);
   EXPECT_LE(ate_optimised, 1.02 * ate_without);
+  // Every correction applied is announced once, on the first pose after it (MAVLink reset_counter).
+  uint64_t announced = 0;
+  for (const FrameOutput& out : with.run.outputs) announced += out.loop_corrected;
+  EXPECT_GE(with.run.stats.loop_corrections_applied, 1u);
+  EXPECT_EQ(announced, with.run.stats.loop_corrections_applied);
 }
 
 TEST(LoopPrecision, OfficePassAlongIdenticalWorkstationsAcceptsNoWrongLoop) {
-  const GradedRun run = runAndGrade(noisySynth("office_pass", 420));
+  const GradedRun run = runAndGrade(noisySynth("office_pass", 300));
   ASSERT_TRUE(run.run.status.ok());
-  printGrading("office_pass (420 frames, Kinect-like noise)", run.grading);
+  printGrading("office_pass (300 frames, Kinect-like noise)", run.grading);
   EXPECT_GT(run.run.result.loop.stats.queries, 0u);
   EXPECT_EQ(run.grading.correct, run.grading.graded);
 }
