@@ -115,7 +115,8 @@ def evaluate(args, seq):
     row["opt"] = ate(args, seq.gt, base + ".opt.txt")
     grading = json_of([args.plumb, "eval", "--gt", seq.gt, "--loops", base + ".stats.json", "--json"])
     if grading:
-        row.update({k: grading[k] for k in ("accepted", "graded", "correct", "revisits", "revisits_recalled")})
+        row.update({k: grading.get(k, 0) for k in ("accepted", "graded", "correct", "within_5cm_2deg", "revisits",
+                                                   "revisits_recalled")})
     with open(base + ".stats.json") as f:
         stats = json.load(f)
     lc = stats.get("loop_closing", {})
@@ -155,7 +156,7 @@ def main():
     rows = [evaluate(args, s) for s in seqs]
 
     print("| sequence | no loops ATE [m] | `--out` ATE [m] | `--out` / no loops | `--out-optimized` ATE [m] | "
-          "opt / no loops | loops accepted / correct | revisits recalled | verdict |")
+          "opt / no loops | loops accepted / correct (within 5 cm, 2 deg) | revisits recalled | verdict |")
     print("|---|---|---|---|---|---|---|---|---|")
     totals = {"rows": 0, "fail_rt": 0, "fail_opt": 0, "accepted": 0, "correct": 0, "revisits": 0, "recalled": 0}
     for r in rows:
@@ -173,7 +174,9 @@ def main():
             verdict.append("rt > 5 %")
             totals["fail_rt"] += 1
         if correct < r.get("graded", 0):
-            verdict.append(f"{r['graded'] - correct} wrong loop(s)")
+            far = r["graded"] - r.get("within_5cm_2deg", 0)
+            verdict.append(f"{r['graded'] - correct} wrong loop(s)" +
+                           (f" ({far} beyond 5 cm / 2 deg)" if far else " (within 5 cm / 2 deg, beyond 3 sigma)"))
         totals["accepted"] += r.get("graded", 0)
         totals["correct"] += correct
         recall = "-"
@@ -182,7 +185,7 @@ def main():
             totals["recalled"] += r["revisits_recalled"]
             recall = f"{r['revisits_recalled']}/{r['revisits']}"
         print(f"| {r['name']} | {fmt(r['noloops'])} | {fmt(r['rt'])} | {rt_ratio:.3f} | {fmt(r['opt'])} | "
-              f"{opt_ratio:.3f} | {accepted} / {correct} | {recall} | {'ok' if not verdict else ', '.join(verdict)} |")
+              f"{opt_ratio:.3f} | {accepted} / {correct} ({r.get('within_5cm_2deg', 0)}) | {recall} | {'ok' if not verdict else ', '.join(verdict)} |")
     precision = 100.0 * totals["correct"] / totals["accepted"] if totals["accepted"] else 100.0
     recall = 100.0 * totals["recalled"] / totals["revisits"] if totals["revisits"] else float("nan")
     print()

@@ -19,9 +19,9 @@ int evalLoops(const std::vector<StampedPose>& ground_truth, const std::string& s
   using runtime::jsonNumber;
   if (json) {
     std::printf("{\"stats\": %s, \"verified\": %zu, \"accepted\": %zu, \"graded\": %zu, \"correct\": %zu, "
-                "\"precision\": %s,\n \"revisit_keyframes\": %zu, \"revisits\": %zu, \"revisits_recalled\": %zu, "
+                "\"within_5cm_2deg\": %zu, \"precision\": %s,\n \"revisit_keyframes\": %zu, \"revisits\": %zu, \"revisits_recalled\": %zu, "
                 "\"recall\": %s,\n \"loops\": [",
-                runtime::jsonString(stats_path).c_str(), g.verified, g.accepted, g.graded, g.correct,
+                runtime::jsonString(stats_path).c_str(), g.verified, g.accepted, g.graded, g.correct, g.within_distance,
                 jsonNumber(g.precision(), "%.4f").c_str(), g.revisit_keyframes, g.revisits, g.revisits_recalled,
                 jsonNumber(g.recall(), "%.4f").c_str());
     for (std::size_t i = 0; i < g.loops.size(); ++i) {
@@ -53,6 +53,8 @@ int evalLoops(const std::vector<StampedPose>& ground_truth, const std::string& s
   std::printf("loop precision %.1f %% (%zu of %zu correct: <= %.0f cm, <= %.0f deg, chi2 <= %.2f)\n",
               100.0 * g.precision(), g.correct, g.graded, options.max_error_m * 100, options.max_error_deg,
               options.max_chi2);
+  std::printf("within %.0f cm and %.0f deg (the covariance aside): %zu of %zu\n", options.max_error_m * 100,
+              options.max_error_deg, g.within_distance, g.graded);
   std::printf("revisit recall %.1f %% (%zu of %zu revisits, %zu revisit keyframes)\n", 100.0 * g.recall(),
               g.revisits_recalled, g.revisits, g.revisit_keyframes);
   return 0;

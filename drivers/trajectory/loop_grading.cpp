@@ -161,7 +161,9 @@ LoopGrading gradeLoops(const std::vector<StampedPose>& gt, const LoopAuditFile& 
       const Eigen::LDLT<Matrix6d> ldlt(c.covariance);
       const double chi2 = ldlt.info() == Eigen::Success ? e.dot(ldlt.solve(e)) : INFINITY;
       l.error_sigmas = std::sqrt(std::max(0.0, chi2));
-      l.correct = l.error_m <= o.max_error_m && l.error_deg <= o.max_error_deg && chi2 <= o.max_chi2;
+      const bool close = l.error_m <= o.max_error_m && l.error_deg <= o.max_error_deg;
+      l.correct = close && chi2 <= o.max_chi2;
+      g.within_distance += close ? 1 : 0;
       ++g.graded;
       if (l.correct) {
         ++g.correct;

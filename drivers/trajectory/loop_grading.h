@@ -74,6 +74,7 @@ struct LoopGrading {
   std::size_t accepted = 0;
   std::size_t graded = 0;  // accepted with ground truth at both ends
   std::size_t correct = 0;
+  std::size_t within_distance = 0;  // within 5 cm and 2 deg whatever their covariance says
   std::vector<GradedLoop> loops;  // the accepted ones
   std::size_t revisit_keyframes = 0;
   std::size_t revisits = 0;
