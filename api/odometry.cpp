@@ -1,5 +1,7 @@
 // plumb::api::Odometry: the public push-style odometry over OdometryStepper (the runner's stages,
 // lock-step). Copies the caller's frame into the one slot, steps, and queues finished poses.
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <memory>
 
@@ -7,6 +9,7 @@
 #include "api/plumb/odometry.h"
 #include "drivers/dataset/camera_presets.h"
 #include "pipeline/run/odometry_stepper.h"
+#include "sensor/rgbd_image.h"
 
 namespace plumb::api {
 
@@ -76,6 +79,8 @@ struct Odometry::Impl {
   std::unique_ptr<FinishedQueue> finished;
   std::unique_ptr<OdometryStepper> stepper;
   bool finished_input = false;
+  bool has_previous_timestamp = false;
+  double previous_timestamp_s = 0;
 };
 
 Odometry::Odometry(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -102,6 +107,25 @@ const CameraValues& Odometry::camera() const { return impl_->camera; }
 
 namespace {
 
+std::string stampText(double t) {
+  char text[40];
+  std::snprintf(text, sizeof text, "%.9g", t);
+  return text;
+}
+
+// The rules of every other way in (TUM lists, recordings): finite, 0..1e10 s, strictly increasing.
+Status checkTimestamp(double t, bool has_previous, double previous) {
+  if (!std::isfinite(t) || t < 0) return Status::Error("frame: timestamp " + stampText(t) + " is not a finite non-negative number");
+  if (t > kMaxTimestampS) {
+    return Status::Error("frame: timestamp " + stampText(t) + " is beyond 1e10 s (the year 2286): seconds are expected");
+  }
+  if (has_previous && !(t > previous)) {
+    return Status::Error(std::string("frame: timestamp ") + stampText(t) + (t == previous ? " repeats" : " goes back from") +
+                         " the previous frame's " + stampText(previous) + " (timestamps must increase)");
+  }
+  return Status::Ok();
+}
+
 Status checkFrame(const FrameView& f, const CameraValues& camera) {
   if (f.color == nullptr || f.depth == nullptr) return Status::Error("frame: colour and depth are required");
   if (f.width != camera.width || f.height != camera.height) {
@@ -118,7 +142,10 @@ Status checkFrame(const FrameView& f, const CameraValues& camera) {
 Status Odometry::track(const FrameView& frame, TrackOutput* out) {
   if (impl_->finished_input) return Status::Error("track() after finish()");
   Status st = checkFrame(frame, impl_->camera);
+  if (st.ok) st = checkTimestamp(frame.timestamp_s, impl_->has_previous_timestamp, impl_->previous_timestamp_s);
   if (!st.ok) return st;
+  impl_->has_previous_timestamp = true;
+  impl_->previous_timestamp_s = frame.timestamp_s;
   RgbdImage& image = impl_->stepper->slot().image;
   const int w = frame.width, h = frame.height;
   const std::size_t color_stride = frame.color_stride ? frame.color_stride : std::size_t(w) * 3;

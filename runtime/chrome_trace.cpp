@@ -1,5 +1,7 @@
 #include "runtime/chrome_trace.h"
 
+#include "platform/input_file.h"
+
 #include <algorithm>
 #include <cinttypes>
 #include <cstdio>
@@ -199,11 +201,12 @@ Status parseChromeTrace(const std::string& text, RunReport* report) {
 }
 
 Status readChromeTrace(const std::string& path, RunReport* report) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) return Status::Error("cannot open trace file " + path);
-  std::ostringstream text;
-  text << file.rdbuf();
-  return parseChromeTrace(text.str(), report).withContext(path);
+  // Opened the one way (platform/input_file.h): regular files only, size bounded before reading.
+  // A trace holds at most 8192 events per stage (RunOptions::trace_capacity_per_stage): a few MB.
+  constexpr uint64_t kMaxTraceBytes = uint64_t(256) << 20;
+  std::string text;
+  PLUMB_RETURN_IF_ERROR(readInputFile(path, kMaxTraceBytes, "trace file", &text));
+  return parseChromeTrace(text, report).withContext(path);
 }
 
 }  // namespace plumb::runtime

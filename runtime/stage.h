@@ -42,6 +42,9 @@ class Source {
   virtual Status read(T& payload, const FrameStamps& stamps) = 0;
   // Consumes the peeked frame without decoding it (real-time mode: no free slot, frame dropped).
   virtual void skip() = 0;
+  // True once the source was asked to stop (a SIGINT): real-time pacing waits in slices and gives
+  // up the wait when this turns true, so a recorded gap of days never outlasts a stop request.
+  virtual bool stopRequested() { return false; }
 };
 
 }  // namespace plumb::runtime

@@ -131,6 +131,22 @@ class StageRunner {
   }
 
   // Recording time -> run-clock time: the first frame is due now, the others keep their spacing.
+  // Real-time pacing's wait: until t_ns, or false as soon as the source reports a stop request
+  // (checked every kStopPollNs: a SIGINT during a long recorded gap ends the run at once).
+  static constexpr int64_t kStopPollNs = 50'000'000;
+  bool sleepUntilOrStop(int64_t t_ns) {
+    if (clock_.isVirtual()) {
+      clock_.sleepUntilNs(t_ns);
+      return true;
+    }
+    for (;;) {
+      if (source_.stopRequested()) return false;
+      const int64_t now = clock_.nowNs();
+      if (now >= t_ns) return true;
+      clock_.sleepUntilNs(std::min(t_ns, now + kStopPollNs));
+    }
+  }
+
   int64_t pacedTimeNs(int64_t t_recorded_ns) {
     if (!have_pacing_origin_) {
       have_pacing_origin_ = true;

@@ -66,7 +66,7 @@ void StageRunner<T>::sourceLoop() {
     SlotIndex slot = 0;
     if (realtime()) {
       t_sensor_ns = pacedTimeNs(t_recorded_ns);
-      clock_.sleepUntilNs(t_sensor_ns);
+      if (!sleepUntilOrStop(t_sensor_ns)) break;  // a stop during a long recorded gap
       if (skipIfLate(frame_index, t_sensor_ns, clock_.nowNs())) continue;
       if (!pool_.tryAcquire(&slot)) {  // every slot busy: drop, never wait
         source_.skip();

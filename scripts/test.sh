@@ -10,26 +10,36 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 JOBS=$(nproc 2>/dev/null || echo 2)
-bash scripts/install_deps.sh
+suite_start=$(date +%s)
+# Prints how long the suite has run so far: CI stops at 90 minutes, the target is under 60 from cold.
+elapsed() { echo "test.sh: $1 at $(( ($(date +%s) - suite_start) / 60 )) min $(( ($(date +%s) - suite_start) % 60 )) s"; }
+trap 'elapsed "stopped"' ERR
+bash scripts/install_deps.sh --tests
+elapsed "packages installed"
 bash scripts/build.sh
+elapsed "Release build done"
 ctest --test-dir build --output-on-failure -j "$JOBS" --timeout 900
+elapsed "Release ctest done"
 
 echo "== ThreadSanitizer: platform/ and runtime/ =="
 cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPLUMB_TSAN_ONLY=ON \
   -DPLUMB_SANITIZE=thread >/dev/null
 cmake --build build-tsan -j "$JOBS"
 TSAN_OPTIONS="halt_on_error=1" ctest --test-dir build-tsan --output-on-failure -j "$JOBS" --timeout 600
+elapsed "ThreadSanitizer done"
 
 echo "== AddressSanitizer + UBSan: every area but system (scripts/sanitize.sh) =="
 PRESET=asan-fast bash scripts/sanitize.sh platform runtime solver pipeline odometry loop drivers devices \
   mavlink api tools mapfile
+elapsed "AddressSanitizer done"
 
 echo "== Fuzzing: every parser, 20 s each (scripts/fuzz.sh) =="
 if command -v clang++ >/dev/null 2>&1; then
   FUZZ_SEED=1 bash scripts/fuzz.sh 20
 else
-  echo "skipped: clang++ not found (scripts/install_deps.sh installs clang and libclang-rt-14-dev)"
+  echo "skipped: clang++ not found (scripts/install_deps.sh --tests installs clang and libclang-rt-14-dev)"
 fi
+elapsed "fuzzing done"
 
 # 5. aarch64: cross build, every unit test under qemu and a replay compared with x86 (docs/EMBEDDED.md;
 #    ~20-25 min on 2 cores from cold, most of it the cross build). PLUMB_CROSS=0 skips it.
@@ -37,3 +47,4 @@ if [ "${PLUMB_CROSS:-1}" = "1" ]; then
   echo "== aarch64 cross build, tests under qemu (scripts/cross_aarch64.sh) =="
   bash scripts/cross_aarch64.sh
 fi
+elapsed "all steps passed"

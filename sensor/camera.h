@@ -10,7 +10,9 @@
 // (undistortPoint) and everything downstream (matching by projection, the solver) works in the
 // ideal pinhole model.
 #include <cmath>
+#include <cstdio>
 #include <string>
+#include <tuple>
 
 #include <Eigen/Core>
 
@@ -75,25 +77,69 @@ struct PinholeCamera {
     return u >= border && v >= border && u < width - border && v < height - border;
   }
 
-  // Empty string when valid; otherwise what is wrong (NaN, zero focal length, bad size...).
-  std::string validate() const {
-    auto finite = [](double x) { return std::isfinite(x); };
-    if (!finite(fx) || !finite(fy) || !finite(cx) || !finite(cy)) return "intrinsics are not finite";
-    if (!finite(k1) || !finite(k2) || !finite(p1) || !finite(p2) || !finite(k3))
-      return "distortion coefficients are not finite";
-    if (fx == 0 || fy == 0) return "focal length is zero";
-    if (width <= 0 || height <= 0) return "image size must be positive";
-    // Bounds checked before anything is allocated for an image (a 100000-pixel-wide "camera" is a
-    // typo or a hostile file, not a sensor): docs/DATA_FORMATS.md.
-    if (width > kMaxImageSide || height > kMaxImageSide)
-      return "image size " + std::to_string(width) + "x" + std::to_string(height) + " exceeds " +
-             std::to_string(kMaxImageSide) + " pixels per side";
-    if (!finite(depth_factor) || depth_factor <= 0) return "depth factor must be positive";
-    if (!finite(baseline_m) || baseline_m <= 0) return "baseline must be positive";
-    if (!finite(rolling_shutter_readout_s) || rolling_shutter_readout_s < 0)
-      return "rolling_shutter_readout must be >= 0";
-    return "";
-  }
+  // Empty string when valid; otherwise what is wrong (NaN, zero focal length, bad size...). Beyond
+  // "a number", each value must be plausible for a real camera (kCameraBounds below): a principal
+  // point off the image, a focal length of 1e300 or 1e-300 pixels, a distortion of 1e6 or a readout
+  // of 1e9 s is a typo or a hostile file, and accepting it tracks "ok" frames into nonsense.
+  std::string validate() const;
 };
+
+// Plausibility bounds of PinholeCamera::validate (docs/DATA_FORMATS.md "Camera").
+struct CameraBounds {
+  // |fx| / width and |fy| / height: a horizontal (vertical) field of view between ~0.6 and ~170 deg.
+  double min_focal_per_side = 0.04, max_focal_per_side = 100.0;
+  double max_radial = 100.0;       // |k1|, |k2|, |k3|
+  double max_tangential = 1.0;     // |p1|, |p2|
+  double min_depth_factor = 1.0, max_depth_factor = 1e5;  // raw units per metre (TUM 5000, mm 1000)
+  double max_baseline_m = 10.0;
+  double max_readout_s = 1.0;      // rolling-shutter readout: below a frame period of 1 fps
+};
+inline constexpr CameraBounds kCameraBounds{};
+
+inline std::string PinholeCamera::validate() const {
+  auto finite = [](double x) { return std::isfinite(x); };
+  auto text = [](double x) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%g", x);
+    return std::string(buffer);
+  };
+  const CameraBounds& b = kCameraBounds;
+  if (!finite(fx) || !finite(fy) || !finite(cx) || !finite(cy)) return "intrinsics are not finite";
+  if (!finite(k1) || !finite(k2) || !finite(p1) || !finite(p2) || !finite(k3))
+    return "distortion coefficients are not finite";
+  if (fx == 0 || fy == 0) return "focal length is zero";
+  if (width <= 0 || height <= 0) return "image size must be positive";
+  // Bounds checked before anything is allocated for an image (a 100000-pixel-wide "camera" is a
+  // typo or a hostile file, not a sensor): docs/DATA_FORMATS.md.
+  if (width > kMaxImageSide || height > kMaxImageSide)
+    return "image size " + std::to_string(width) + "x" + std::to_string(height) + " exceeds " +
+           std::to_string(kMaxImageSide) + " pixels per side";
+  if (!(cx >= 0 && cx <= width && cy >= 0 && cy <= height))
+    return "principal point (" + text(cx) + ", " + text(cy) + ") is outside the " + std::to_string(width) + "x" +
+           std::to_string(height) + " image";
+  for (const auto& [name, f, side] : {std::tuple<const char*, double, int>{"fx", fx, width}, {"fy", fy, height}}) {
+    const double ratio = std::abs(f) / side;
+    if (ratio < b.min_focal_per_side || ratio > b.max_focal_per_side)
+      return std::string("focal length ") + name + " " + text(f) + " is implausible for a " + std::to_string(side) +
+             "-pixel side (|" + name + "| must be within " + text(b.min_focal_per_side * side) + ".." +
+             text(b.max_focal_per_side * side) + " pixels)";
+  }
+  if (std::abs(k1) > b.max_radial || std::abs(k2) > b.max_radial || std::abs(k3) > b.max_radial)
+    return "radial distortion k1 k2 k3 (" + text(k1) + " " + text(k2) + " " + text(k3) + ") beyond +-" +
+           text(b.max_radial);
+  if (std::abs(p1) > b.max_tangential || std::abs(p2) > b.max_tangential)
+    return "tangential distortion p1 p2 (" + text(p1) + " " + text(p2) + ") beyond +-" + text(b.max_tangential);
+  if (!finite(depth_factor) || depth_factor <= 0) return "depth factor must be positive";
+  if (depth_factor < b.min_depth_factor || depth_factor > b.max_depth_factor)
+    return "depth factor " + text(depth_factor) + " outside " + text(b.min_depth_factor) + ".." +
+           text(b.max_depth_factor) + " raw units per metre";
+  if (!finite(baseline_m) || baseline_m <= 0) return "baseline must be positive";
+  if (baseline_m > b.max_baseline_m) return "baseline " + text(baseline_m) + " m beyond " + text(b.max_baseline_m) + " m";
+  if (!finite(rolling_shutter_readout_s) || rolling_shutter_readout_s < 0)
+    return "rolling_shutter_readout must be >= 0";
+  if (rolling_shutter_readout_s > b.max_readout_s)
+    return "rolling_shutter_readout " + text(rolling_shutter_readout_s) + " s beyond " + text(b.max_readout_s) + " s";
+  return "";
+}
 
 }  // namespace plumb

@@ -8,6 +8,12 @@
 
 namespace plumb {
 
+// The largest frame timestamp plumb accepts, in seconds: 1e10 s is the year 2286 in Unix time.
+// Larger stamps are nanoseconds or microseconds written as seconds, or garbage (1e300): refused
+// where frames enter (lists, recordings, the API), so one such frame can neither sleep a realtime
+// replay for years nor make every later (correct) frame look like a step back in time.
+constexpr double kMaxTimestampS = 1e10;
+
 struct RgbdImage {
   uint64_t sequence = 0;        // 0, 1, 2, ... in delivery order (gaps = frames the source lost)
   double timestamp_s = 0;       // sensor/recording time in seconds (TUM: the rgb timestamp)

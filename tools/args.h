@@ -1,11 +1,17 @@
 #pragma once
 // Tiny argument reader shared by the subcommands: `--key value`, `--flag`, and positionals.
-// Unknown options are an error, so a typo never silently falls back to a default.
+// Unknown options are an error, so a typo never silently falls back to a default; so is an empty
+// value (`--out ""` never means "none"). Numbers go through the one parser of tools/flags.h
+// (whole numbers in 64 bits, range-checked before any narrowing). New commands declare their flags
+// in a FlagTable (tools/flags.h) instead.
+#include <climits>
 #include <cstdlib>
 #include <map>
 #include <set>
 #include <string>
 #include <vector>
+
+#include "tools/flags.h"
 
 namespace plumb::tools {
 
@@ -24,6 +30,7 @@ class Args {
         }
         if (value_options.count(key)) {
           if (i + 1 >= argc) { error_ = "option --" + key + " needs a value"; return; }
+          if (argv[i + 1][0] == '\0') { error_ = "option --" + key + " needs a value (an empty string is not one)"; return; }
           values_[key] = argv[++i];
         } else if (flag_options.count(key)) {
           flags_.insert(key);
@@ -43,21 +50,25 @@ class Args {
     auto it = values_.find(key);
     return it == values_.end() ? fallback : it->second;
   }
-  // Parses an integer option; sets *ok=false (and leaves fallback) when malformed.
-  long getInt(const std::string& key, long fallback, bool* ok) const {
+  // An integer option in min..max (usage error naming the flag otherwise); *value keeps its
+  // default when the option is absent.
+  Status integer(const std::string& key, long long min, long long max, long long* value) const {
     auto it = values_.find(key);
-    if (it == values_.end()) return fallback;
-    char* end = nullptr;
-    long v = std::strtol(it->second.c_str(), &end, 10);
-    if (end == it->second.c_str() || *end != '\0') { *ok = false; return fallback; }
-    return v;
+    return it == values_.end() ? Status::Ok() : parseIntegerValue(key, it->second, min, max, value);
+  }
+  Status real(const std::string& key, double min, double max, double* value) const {
+    auto it = values_.find(key);
+    return it == values_.end() ? Status::Ok() : parseRealValue(key, it->second, min, max, value);
+  }
+  // Older form: sets *ok=false (and leaves fallback) when malformed or beyond a long.
+  long getInt(const std::string& key, long fallback, bool* ok) const {
+    long long v = fallback;
+    if (!integer(key, LONG_MIN, LONG_MAX, &v).ok()) *ok = false;
+    return long(v);
   }
   double getDouble(const std::string& key, double fallback, bool* ok) const {
-    auto it = values_.find(key);
-    if (it == values_.end()) return fallback;
-    char* end = nullptr;
-    double v = std::strtod(it->second.c_str(), &end);
-    if (end == it->second.c_str() || *end != '\0') { *ok = false; return fallback; }
+    double v = fallback;
+    if (!real(key, -1e308, 1e308, &v).ok()) *ok = false;
     return v;
   }
   const std::vector<std::string>& positional() const { return positional_; }

@@ -85,8 +85,11 @@ int benchFrontend(int argc, char** argv) {
 
   cv::setNumThreads(1);  // single thread, for both paths
   ExtractorOptions options;
-  options.line_level = static_cast<int>(args.getInt("line-level", options.line_level, &ok));
-  options.line_samples = static_cast<int>(args.getInt("line-samples", options.line_samples, &ok));
+  long long line_level = options.line_level, line_samples = options.line_samples;
+  ok = args.integer("line-level", 0, options.num_levels - 1, &line_level).ok() &&
+       args.integer("line-samples", 0, long(kMaxLineSamples), &line_samples).ok() && ok;
+  options.line_level = int(line_level);
+  options.line_samples = int(line_samples);
   options.use_opencv_lsd = args.has("opencv-lsd");
   const std::string clock = args.get("clock", "wall");
   if (clock != "wall" && clock != "cpu") {

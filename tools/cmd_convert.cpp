@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "drivers/common/atomic_file.h"
 #include "drivers/open/open_source.h"
 #include "drivers/recording/recording_source.h"
 #include "drivers/recording/recording_writer.h"
@@ -33,8 +34,15 @@ int folderToRecording(const std::string& in, const std::string& out, const std::
   std::unique_ptr<plumb::FrameSource> source;
   plumb::Status st = plumb::openFrameSource(in, camera, &source);
   if (!st.ok()) return fail(st.message());
+  // Written aside and renamed into place when complete (drivers/common/atomic_file.h): a
+  // conversion that fails part-way (a bad frame, a full disk) leaves an existing recording of that
+  // name as it was and no partial file behind. (`plumb record` writes in place by design: a live
+  // recording must survive a power cut.)
+  plumb::AtomicFile staging;
+  st = staging.open(out);
+  if (!st.ok()) return fail(st.message());
   std::unique_ptr<plumb::RecordingWriter> writer;
-  st = plumb::RecordingWriter::open(out, source->camera(), {}, &writer);
+  st = plumb::RecordingWriter::open(staging.temporaryPath(), source->camera(), {}, &writer);
   if (!st.ok()) return fail(st.message());
   plumb::RgbdImage frame;
   for (;;) {
@@ -45,6 +53,7 @@ int folderToRecording(const std::string& in, const std::string& out, const std::
     if (!st.ok()) return fail(st.message());
   }
   st = writer->close();
+  if (st.ok()) st = staging.commit();
   if (!st.ok()) return fail(st.message());
   std::printf("%s -> %s: %llu frames, %.1f MB\n", in.c_str(), out.c_str(),
               static_cast<unsigned long long>(writer->framesWritten()), writer->bytesWritten() / 1e6);
@@ -56,19 +65,31 @@ int recordingToFolder(const std::string& in, const std::string& out, const std::
   plumb::Status st = plumb::openFrameSource(in, camera, &opened);
   if (!st.ok()) return fail(st.message());
   auto* recording = dynamic_cast<plumb::RecordingSource*>(opened.get());
+  // A conversion that fails part-way leaves no half dataset: the folder (empty or new before)
+  // is emptied again, so nothing can be mistaken for a whole conversion.
+  const bool folder_existed = std::filesystem::exists(out);
+  auto failAndClean = [&](const std::string& message) {
+    std::error_code ec;
+    if (folder_existed) {
+      for (const auto& entry : std::filesystem::directory_iterator(out, ec)) std::filesystem::remove_all(entry.path(), ec);
+    } else {
+      std::filesystem::remove_all(out, ec);
+    }
+    return fail(message + " (nothing was kept in " + out + ")");
+  };
   std::unique_ptr<plumb::TumFolderWriter> writer;
   st = plumb::TumFolderWriter::open(out, opened->camera(), &writer);
-  if (!st.ok()) return fail(st.message());
+  if (!st.ok()) return failAndClean(st.message());
   plumb::RgbdImage frame;
   for (;;) {
     const plumb::SourceResult r = opened->next(frame);
     if (r == plumb::SourceResult::kEndOfStream) break;
-    if (r != plumb::SourceResult::kFrame) return fail(opened->lastError().message());
+    if (r != plumb::SourceResult::kFrame) return failAndClean(opened->lastError().message());
     st = writer->append(frame);
-    if (!st.ok()) return fail(st.message());
+    if (!st.ok()) return failAndClean(st.message());
   }
   st = writer->close();
-  if (!st.ok()) return fail(st.message());
+  if (!st.ok()) return failAndClean(st.message());
   std::printf("%s -> %s: %llu frames\n", in.c_str(), out.c_str(),
               static_cast<unsigned long long>(writer->framesWritten()));
   if (recording) {

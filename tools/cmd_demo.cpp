@@ -1,6 +1,7 @@
 // plumb demo: the odometry system on the built-in synthetic scenes (rendered in memory, Kinect-like
 // depth noise, exact ground truth): ATE RMSE and ms per frame, and on the low-texture scene the
 // paper's comparison of point + line guidance features against points only.
+#include <climits>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -42,12 +43,13 @@ int runDemo(int argc, char** argv) {
     printDemoUsage();
     return 2;
   }
-  bool ok = true;
-  const long frames = args.getInt("frames", 600, &ok);
-  const long seed = args.getInt("seed", 1, &ok);
-  const long line_samples = args.getInt("line-samples", 5, &ok);
-  if (!ok || frames <= 0 || seed < 0 || line_samples < 0 || line_samples == 1 || line_samples > long(kMaxLineSamples)) {
-    std::fprintf(stderr, "plumb demo: --frames > 0, --seed >= 0, --line-samples 0 or 2..%zu\n", kMaxLineSamples);
+  long long frames = 600, seed = 1, line_samples = 5;
+  Status parsed = args.integer("frames", 1, 10'000'000, &frames);
+  if (parsed.ok()) parsed = args.integer("seed", 0, LLONG_MAX, &seed);
+  if (parsed.ok()) parsed = args.integer("line-samples", 0, long(kMaxLineSamples), &line_samples);
+  if (parsed.ok() && line_samples == 1) parsed = Status::Error("--line-samples takes 0 or 2..10 (1 point is not a line)");
+  if (!parsed.ok()) {
+    std::fprintf(stderr, "plumb demo: %s\n", parsed.message().c_str());
     return 2;
   }
 

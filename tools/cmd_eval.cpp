@@ -11,6 +11,7 @@
 #include "tools/args.h"
 #include "tools/command.h"
 #include "tools/eval_loops.h"
+#include "tools/io_plan.h"
 
 namespace plumb::tools {
 namespace {
@@ -94,7 +95,7 @@ int runEval(int argc, char** argv) {
     return 2;
   }
   const std::string gt_path = args.get("gt"), est_path = args.get("est"), plot_path = args.get("plot");
-  if (loops) {
+  if (loops) {  // reads the ground truth and the statistics, writes nothing
     std::vector<StampedPose> ground_truth;
     TrajectoryReadReport report;
     const Status st = readTrajectory("ground truth", gt_path, &ground_truth, &report);
@@ -103,6 +104,17 @@ int runEval(int argc, char** argv) {
       return 1;
     }
     return evalLoops(ground_truth, args.get("loops"), args.has("json"));
+  }
+  // The plot never overwrites an input (the ground truth, the estimate, a link to either), and
+  // its folder must take it: checked before anything is read.
+  IoPlan io;
+  if (!isSynthSpec(gt_path)) io.addInput(gt_path);
+  io.addInput(est_path);
+  io.addOutput("--plot", plot_path);
+  const Status io_status = io.check();
+  if (!io_status.ok()) {
+    std::fprintf(stderr, "plumb eval: %s\n", io_status.message().c_str());
+    return 2;
   }
   std::vector<StampedPose> ground_truth, estimate;
   TrajectoryReadReport gt_report, est_report;

@@ -14,6 +14,7 @@
 #include "runtime/run_report.h"
 #include "tools/args.h"
 #include "tools/command.h"
+#include "tools/io_plan.h"
 
 namespace plumb::tools {
 namespace {
@@ -102,7 +103,7 @@ Status drawHistograms(const runtime::RunReport& report, const std::string& path)
     drawPanel(canvas, i * kPanelHeight, report.stages[i].name, report.stages[i].latency, first, last);
   }
   drawPanel(canvas, (panels - 1) * kPanelHeight, "end-to-end", report.end_to_end, first, last);
-  return writePngFile(path, canvas, pngFastestOptions());
+  return writePngOutput(path, canvas, pngFastestOptions());
 }
 
 int profileCommand(int argc, char** argv) {
@@ -115,6 +116,15 @@ int profileCommand(int argc, char** argv) {
                  "  latency per stage and end to end, dropped frames and frames per second.\n"
                  "  --png  also draw one latency histogram per stage (log time axis)\n");
     return args.help() ? 0 : 2;
+  }
+  // The histogram never overwrites the trace (or a link to it), and its folder must take it.
+  IoPlan io;
+  io.addInput(args.positional()[0]);
+  io.addOutput("--png", args.get("png"));
+  const Status io_status = io.check();
+  if (!io_status.ok()) {
+    std::fprintf(stderr, "plumb profile: %s\n", io_status.message().c_str());
+    return 2;
   }
   runtime::RunReport report;
   const Status status = runtime::readChromeTrace(args.positional()[0], &report);

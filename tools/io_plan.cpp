@@ -6,6 +6,8 @@
 #include <climits>
 #include <cstdlib>
 
+#include "drivers/common/atomic_file.h"
+
 namespace plumb::tools {
 namespace {
 
@@ -55,7 +57,11 @@ void IoPlan::addOutput(const std::string& flag, const std::string& path) {
 Status IoPlan::check() const {
   for (std::size_t i = 0; i < outputs_.size(); ++i) {
     const Output& out = outputs_[i];
-    const std::string folder = folderOf(out.path);
+    // Outputs are written through symlinks (AtomicFile): the folder that matters is the target's.
+    std::string target;
+    const Status resolved = resolveOutputTarget(out.path, &target);
+    if (!resolved.ok()) return Status::Error(out.flag + " " + resolved.message());
+    const std::string folder = folderOf(target);
     bool folder_is_dir = false;
     FileId folder_id;
     if (!fileId(folder, &folder_id, &folder_is_dir) || !folder_is_dir) {
@@ -91,12 +97,18 @@ Status IoPlan::check() const {
         }
       }
     }
+    // Finally write a probe file where the output will be written (through a symlink to its
+    // target): /proc, a read-only mount or a symlink loop fail here, before any work.
+    const Status writable = probeOutputPath(out.path);
+    if (!writable.ok()) return Status::Error(out.flag + " " + writable.message());
     for (std::size_t j = 0; j < i; ++j) {
       const Output& other = outputs_[j];
       FileId other_id;
-      const bool same_name = realPath(folderOf(other.path)) == realPath(folder) &&
-                             other.path.substr(other.path.find_last_of('/') + 1) ==
-                                 out.path.substr(out.path.find_last_of('/') + 1);
+      std::string other_target;
+      if (!resolveOutputTarget(other.path, &other_target).ok()) other_target = other.path;
+      const bool same_name = realPath(folderOf(other_target)) == realPath(folder) &&
+                             other_target.substr(other_target.find_last_of('/') + 1) ==
+                                 target.substr(target.find_last_of('/') + 1);
       if (same_name || (exists && fileId(other.path, &other_id) && other_id == out_id)) {
         return Status::Error(out.flag + " and " + other.flag + " name the same file " + out.path);
       }

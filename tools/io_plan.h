@@ -18,7 +18,9 @@ class IoPlan {
   void addOutput(const std::string& flag, const std::string& path);
   // Each output: its folder exists and is writable; it is not a folder; it is not an input (same
   // file, compared by device and inode, so links and ../ spellings are caught) and not an existing
-  // file inside an input folder; no two outputs are the same file.
+  // file inside an input folder; no two outputs are the same file; a probe file can be created
+  // where it will be written (drivers/common/atomic_file.h probeOutputPath: through a symlink to
+  // its target, so /proc or a read-only mount fail here, before any work).
   Status check() const;
 
  private:

@@ -1,6 +1,8 @@
 #include "tools/run_outputs.h"
 
+#include <algorithm>
 #include <cinttypes>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 
@@ -14,7 +16,7 @@ namespace plumb::tools {
 
 RunOutputs::RunOutputs(const RunOutputOptions& options) : options_(options), statistics_(options.rss_every) {
   // Reserved once so keeping poses for the ATE costs no allocation per frame.
-  if (options_.keep_trajectory) trajectory_.reserve(options_.expected_frames);
+  if (options_.keep_trajectory) trajectory_.reserve(std::min(options_.expected_frames, kMaxReservedPoses));
 }
 
 namespace {
@@ -80,10 +82,52 @@ void RunOutputs::onPose(const FrameOutput& out) {
   mavlink_->publish(sample);
 }
 
-Status RunOutputs::close() {
+Status RunOutputs::close(bool keep) {
+  endProgress();
+  if (!keep) {
+    trajectory_writer_.abandon();
+    covariance_writer_.abandon();
+    if (frames_stream_ != nullptr) std::fclose(frames_stream_);
+    frames_stream_ = nullptr;
+    return Status::Ok();
+  }
   if (!options_.trajectory_path.empty()) PLUMB_RETURN_IF_ERROR(trajectory_writer_.close());
   if (!options_.covariance_path.empty()) PLUMB_RETURN_IF_ERROR(covariance_writer_.close());
   return Status::Ok();
+}
+
+void RunOutputs::endProgress() {
+  if (!progress_line_open_) return;
+  std::fputc('\n', stderr);
+  progress_line_open_ = false;
+}
+
+void RunOutputs::progressLine(uint64_t frame, const FrameOutput& out) {
+  const int64_t now = monotonicNowNs();
+  if (progress_start_ns_ == 0) progress_start_ns_ = now;
+  if (options_.progress_on_terminal) {
+    if (now - progress_last_ns_ < 250'000'000 && frame != options_.expected_frames) return;
+  } else if (frame % 100 != 0) {
+    return;
+  }
+  progress_last_ns_ = now;
+  const double seconds = double(now - progress_start_ns_) * 1e-9;
+  const double fps = seconds > 0 ? double(frame) / seconds : 0.0;
+  char count[64], eta[48] = "";
+  const std::size_t total = options_.expected_frames;
+  if (total >= frame && total > 0) {
+    std::snprintf(count, sizeof count, "frame %" PRIu64 "/%zu (%.0f%%)", frame, total, 100.0 * double(frame) / double(total));
+    if (fps > 0) {
+      const long long left = std::llround(double(total - frame) / fps);
+      std::snprintf(eta, sizeof eta, ", ETA %lld:%02lld", left / 60, left % 60);
+    }
+  } else {
+    std::snprintf(count, sizeof count, "frame %" PRIu64, frame);
+  }
+  std::fprintf(stderr, "%s%s, %.1f frames/s%s: %s, keyframes %" PRIu64 ", without pose %" PRIu64 "%s",
+               options_.progress_on_terminal ? "\r" : "", count, fps, eta, toString(out.state), keyframes_, lost_,
+               options_.progress_on_terminal ? "\x1b[K" : "\n");
+  progress_line_open_ = options_.progress_on_terminal;
 }
 
 void RunOutputs::reportBlock(const FrameOutput& out) {
@@ -120,10 +164,7 @@ Status RunOutputs::onFrame(const FrameOutput& out) {
                  out.insert.new_points, out.insert.new_lines, out.relocalized, out.track.used_motion_fallback,
                  t.x(), t.y(), t.z());
   }
-  if (options_.progress && frame % 100 == 0) {
-    std::fprintf(stderr, "frame %" PRIu64 ": %s, keyframes %" PRIu64 ", without pose %" PRIu64 "\n", frame,
-                 toString(out.state), keyframes_, lost_);
-  }
+  if (options_.progress) progressLine(frame, out);
   return Status::Ok();
 }
 
@@ -188,18 +229,19 @@ Status runToOutputs(FrameSource& source, const SystemOptions& system_options, co
                     RunOutputs& outputs, RunRecord* record) {
   std::unique_ptr<OdometrySystem> system;
   PLUMB_RETURN_IF_ERROR(OdometrySystem::create(source.camera(), system_options, &system));
-  PLUMB_RETURN_IF_ERROR(validate(run_options));
   PLUMB_RETURN_IF_ERROR(outputs.open());
   SourceCapture capture(source);
-  Status status = runOdometry(capture, *system, outputs, run_options, &record->run);
-  const Status closed = outputs.close();
-  if (status.ok()) status = closed;
-  const Status optimized = outputs.writeOptimized(record->run.loop);
-  if (status.ok()) status = optimized;
+  const Status status = runOdometry(capture, *system, outputs, run_options, &record->run);
+  // The outputs hold what was computed whatever ended the run, but a run that produced no frame
+  // (it failed or was stopped before its first one) replaces no file: an older trajectory of that
+  // name is worth more than an empty one.
+  record->outputs_kept = record->run.frames + record->run.frames_dropped > 0;
+  record->outputs_status = outputs.close(record->outputs_kept);
+  if (record->outputs_kept && record->outputs_status.ok()) record->outputs_status = outputs.writeOptimized(record->run.loop);
   record->odometry = system->stats();
   record->mapper = system->mapperStats();
   record->mapper_waits = system->mapperWaits();
-  return status;
+  return status.ok() ? record->outputs_status : status;
 }
 
 }  // namespace plumb::tools

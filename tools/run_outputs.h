@@ -24,9 +24,15 @@ struct RunOutputOptions {
   // the final pose graph, written at the end of the run ('' = none).
   std::string optimized_path;
   bool keep_trajectory = true;  // poses in memory (for the ATE); off for very long runs
-  std::size_t expected_frames = 0;  // reserve for the kept poses (0: unknown, the vector grows)
+  // Frames the run will see (0: unknown): the progress line's ETA, and the poses reserved at
+  // start (at most kMaxReservedPoses: a flag like --max-frames 10^12 over a recording of unknown
+  // length is never a size to allocate; beyond it the vector grows, rarely, by doubling).
+  std::size_t expected_frames = 0;
   long rss_every = 0;           // > 0: an RSS checkpoint every this many frames
-  bool progress = false;        // a line per 100 frames on stderr
+  // A progress line on stderr (frames, frames/s, ETA). On a terminal it is one line rewritten in
+  // place at most 4 times a second; otherwise a line every 100 frames.
+  bool progress = false;
+  bool progress_on_terminal = false;
   bool trace = false;           // a line per frame on stderr (matches, inliers, keyframes, pose)
   // > 0: every this many frames a line on stdout with the block's sensor-to-pose p99, drops and
   // resident memory (soak tests: scripts/soak.sh).
@@ -39,8 +45,13 @@ class RunOutputs final : public OdometrySink {
  public:
   explicit RunOutputs(const RunOutputOptions& options);
   ~RunOutputs() override;
+  static constexpr std::size_t kMaxReservedPoses = 108'000;  // an hour at 30 Hz
   Status open();   // the files
-  Status close();  // flushes and closes them
+  // Flushes and closes them, under their names (keep) or not at all (abandon: the run produced
+  // nothing valid, e.g. it failed before its first frame; an older file of that name stays).
+  Status close(bool keep = true);
+  bool anyFile() const { return !options_.trajectory_path.empty() || !options_.covariance_path.empty() || !options_.optimized_path.empty(); }
+  void endProgress();  // ends the terminal's progress line
 
   void onPose(const FrameOutput& frame) override;
   Status onFrame(const FrameOutput& frame) override;
@@ -60,6 +71,7 @@ class RunOutputs final : public OdometrySink {
 
  private:
   void reportBlock(const FrameOutput& frame);
+  void progressLine(uint64_t frame, const FrameOutput& out);
 
   RunOutputOptions options_;
   TumTrajectoryWriter trajectory_writer_;
@@ -78,6 +90,8 @@ class RunOutputs final : public OdometrySink {
   std::atomic<uint64_t> dropped_total_{0};
   uint64_t dropped_at_block_start_ = 0;
   uint64_t keyframes_ = 0, lost_ = 0;
+  int64_t progress_start_ns_ = 0, progress_last_ns_ = 0;
+  bool progress_line_open_ = false;
 };
 
 // What a run leaves besides its outputs.
@@ -86,10 +100,15 @@ struct RunRecord {
   OdometryStats odometry;
   MapperStats mapper;
   uint64_t mapper_waits = 0;  // threaded runs: times tracking waited for a lagging map stage
+  // The output files: written under their names (false: the run produced no frame, nothing was
+  // replaced), and how that went (a full disk: nothing under the names either).
+  bool outputs_kept = false;
+  Status outputs_status;
 };
 
-// Builds the system (options validated there), runs it over `source` through the one runner into
-// `outputs` (opened first, closed after, also when the run failed: what was computed is kept).
+// Builds the system, runs it over `source` through the one runner into `outputs` (opened first,
+// closed after, also when the run failed: what was computed is kept; a run that produced no frame
+// replaces no file). The options were validated by the caller's plan (tools/run_plan.cpp).
 Status runToOutputs(FrameSource& source, const SystemOptions& system_options, const OdometryRunOptions& run_options,
                     RunOutputs& outputs, RunRecord* record);
 

@@ -17,6 +17,7 @@
 
 #include <cstring>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -72,27 +73,51 @@ py::array_t<double> matrixToNumpy(const double* column_major, int rows, int cols
 
 py::object poseToNumpy(const Eigen::Isometry3d& T) { return matrixToNumpy(T.matrix().data(), 4, 4); }
 
+// A camera dict's value: a Python int or float (not a bool, not a string), else a TypeError naming
+// the key; the values are then checked like a camera file's (sensor/camera.h bounds).
+double cameraNumber(const std::string& key, const py::handle& value) {
+  if (py::isinstance<py::bool_>(value) || !(py::isinstance<py::int_>(value) || py::isinstance<py::float_>(value))) {
+    throw py::type_error("camera value '" + key + "' must be a number, got " +
+                         std::string(py::str(value.get_type().attr("__name__"))));
+  }
+  return value.cast<double>();
+}
+
+int cameraInteger(const std::string& key, const py::handle& value) {
+  if (py::isinstance<py::bool_>(value) || !py::isinstance<py::int_>(value)) {
+    throw py::type_error("camera value '" + key + "' must be an int, got " +
+                         std::string(py::str(value.get_type().attr("__name__"))));
+  }
+  const long long v = value.cast<long long>();
+  if (v < 1 || v > 1'000'000) throw py::value_error("camera value '" + key + "' " + std::to_string(v) + " is out of range");
+  return int(v);
+}
+
 api::CameraValues cameraFromDict(const py::dict& d) {
   api::CameraValues v;
   for (auto item : d) {
+    if (!py::isinstance<py::str>(item.first)) throw py::type_error("camera keys must be strings");
     const std::string key = py::str(item.first);
     const py::handle value = item.second;
-    if (key == "fx") v.fx = value.cast<double>();
-    else if (key == "fy") v.fy = value.cast<double>();
-    else if (key == "cx") v.cx = value.cast<double>();
-    else if (key == "cy") v.cy = value.cast<double>();
-    else if (key == "k1") v.k1 = value.cast<double>();
-    else if (key == "k2") v.k2 = value.cast<double>();
-    else if (key == "p1") v.p1 = value.cast<double>();
-    else if (key == "p2") v.p2 = value.cast<double>();
-    else if (key == "k3") v.k3 = value.cast<double>();
-    else if (key == "width") v.width = value.cast<int>();
-    else if (key == "height") v.height = value.cast<int>();
-    else if (key == "depth_factor") v.depth_factor = value.cast<double>();
-    else if (key == "baseline") v.baseline_m = value.cast<double>();
-    else if (key == "rolling_shutter_readout") v.rolling_shutter_readout_s = value.cast<double>();
+    if (key == "fx") v.fx = cameraNumber(key, value);
+    else if (key == "fy") v.fy = cameraNumber(key, value);
+    else if (key == "cx") v.cx = cameraNumber(key, value);
+    else if (key == "cy") v.cy = cameraNumber(key, value);
+    else if (key == "k1") v.k1 = cameraNumber(key, value);
+    else if (key == "k2") v.k2 = cameraNumber(key, value);
+    else if (key == "p1") v.p1 = cameraNumber(key, value);
+    else if (key == "p2") v.p2 = cameraNumber(key, value);
+    else if (key == "k3") v.k3 = cameraNumber(key, value);
+    else if (key == "width") v.width = cameraInteger(key, value);
+    else if (key == "height") v.height = cameraInteger(key, value);
+    else if (key == "depth_factor") v.depth_factor = cameraNumber(key, value);
+    else if (key == "baseline") v.baseline_m = cameraNumber(key, value);
+    else if (key == "rolling_shutter_readout") v.rolling_shutter_readout_s = cameraNumber(key, value);
     else throw py::value_error("unknown camera key '" + key + "' (fx fy cx cy k1 k2 p1 p2 k3 width height "
                                "depth_factor baseline rolling_shutter_readout)");
+  }
+  for (const char* required : {"fx", "fy", "cx", "cy"}) {
+    if (!d.contains(required)) throw py::value_error(std::string("camera dict needs '") + required + "' (fx fy cx cy are required)");
   }
   return v;
 }
@@ -204,6 +229,24 @@ api::PixelFormat parseFormat(const std::string& format) {
   throw py::value_error("format must be 'rgb' or 'bgr', got '" + format + "'");
 }
 
+// One Odometry object serves one thread at a time: track() releases the GIL while it runs, and the
+// system behind it is not made for concurrent calls. A second call while one is running (from
+// another thread) is REFUSED with a RuntimeError, never run concurrently and never queued silently
+// (docs/API.md "Python": use one object per thread, or a lock around the calls).
+class BusyGuard {
+ public:
+  BusyGuard(std::mutex& busy, const char* call) : lock_(busy, std::try_to_lock) {
+    if (!lock_.owns_lock()) {
+      throw std::runtime_error(std::string("Odometry.") + call +
+                               ": this object is in use by another thread (one Odometry serves one thread at a time; "
+                               "use one object per thread or a lock around the calls)");
+    }
+  }
+
+ private:
+  std::unique_lock<std::mutex> lock_;
+};
+
 class PyOdometry {
  public:
   PyOdometry(const py::object& camera, bool lines, int line_samples, int output_delay, bool loop_closing) {
@@ -223,6 +266,7 @@ class PyOdometry {
   }
 
   PyTrackResult track(const py::array& rgb, const py::array& depth, double t, const std::string& format) {
+    const BusyGuard guard(busy_, "track");
     const api::CameraValues& c = odometry_->camera();
     const api::PixelFormat pixel_format = parseFormat(format);
     checkImage<uint8_t>(rgb, "rgb", "uint8", 3, c.width, c.height);
@@ -239,11 +283,14 @@ class PyOdometry {
       py::gil_scoped_release release;  // the arrays stay alive: the caller holds them
       st = odometry_->track(frame, &out_);
     }
-    throwIfError(st);
+    // A bad frame (its timestamp: NaN, negative, not after the previous one) is the caller's
+    // input: ValueError, like a wrong shape. Failures of the library are RuntimeError.
+    throwIfError(st, st.message.rfind("frame:", 0) == 0);
     return toPy(out_);
   }
 
   py::list finished() {
+    const BusyGuard guard(busy_, "finished");
     py::list list;
     api::FinishedPose pose;
     while (odometry_->popFinished(&pose)) {
@@ -252,13 +299,20 @@ class PyOdometry {
     return list;
   }
 
-  void finish() { throwIfError(odometry_->finish()); }
-  py::dict counters() const { return countersToDict(odometry_->counters()); }
+  void finish() {
+    const BusyGuard guard(busy_, "finish");
+    throwIfError(odometry_->finish());
+  }
+  py::dict counters() {
+    const BusyGuard guard(busy_, "counters");
+    return countersToDict(odometry_->counters());
+  }
   py::dict camera() const { return cameraToDict(odometry_->camera()); }
 
  private:
   std::unique_ptr<api::Odometry> odometry_;
   api::TrackOutput out_;
+  std::mutex busy_;
 };
 
 class PyFrameReader {

@@ -16,6 +16,10 @@ class SkipFramesSource : public FrameSource {
   SkipFramesSource(std::unique_ptr<FrameSource> inner, uint64_t skip) : inner_(std::move(inner)), skip_(skip) {}
 
   SourceResult next(RgbdImage& out) override {
+    // A source that knows its length ends at once when everything is skipped: nothing is read,
+    // so --skip-frames 10000000 over a 300-frame scene costs nothing.
+    const std::size_t known = inner_->frameCount();
+    if (known > 0 && skip_ >= known) return SourceResult::kEndOfStream;
     while (skipped_ < skip_) {
       const SourceResult r = inner_->next(out);
       if (r == SourceResult::kNoFrame) continue;

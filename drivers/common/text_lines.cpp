@@ -4,7 +4,8 @@
 #include <climits>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
+
+#include "platform/input_file.h"
 
 namespace plumb {
 namespace {
@@ -23,29 +24,37 @@ void splitTokens(const std::string& text, std::size_t begin, std::vector<std::st
 
 }  // namespace
 
-Status readTextLines(const std::string& path, std::vector<TextLine>* out) {
-  out->clear();
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status::Error(path + ": cannot open (" + std::strerror(errno) + ")");
-  std::string text;
-  int number = 0;
-  while (std::getline(in, text)) {
-    ++number;
+Status forEachTextLine(const std::string& path, const std::function<bool(const TextLine&, Status*)>& on_line,
+                       uint64_t max_bytes) {
+  // Bounded, streamed, non-blocking open (platform/input_file.h): /dev/zero, a FIFO or a
+  // gigabyte of one line fails at once in bounded memory instead of being read whole.
+  TextLine line;
+  return forEachInputLine(path, max_bytes, "", [&](int number, const std::string& text, Status* error) {
     std::size_t first = 0;
     while (first < text.size() && isSeparator(text[first])) ++first;
-    if (first == text.size()) continue;
-    if (text.find('\0') != std::string::npos)
-      return Status::Error(fileLine(path, number) + ": binary data in a text file");
-    TextLine line;
+    if (first == text.size()) return true;
     line.number = number;
     line.is_comment = text[first] == '#';
+    line.tokens.clear();
     // A `#` after the data starts a trailing comment (`fx 517.3  # Freiburg 1`).
-    if (!line.is_comment) text = text.substr(0, text.find('#'));
-    splitTokens(text, line.is_comment ? first + 1 : first, &line.tokens);
-    out->push_back(std::move(line));
-  }
-  if (in.bad()) return Status::Error(path + ": read error");
-  return Status::Ok();
+    if (line.is_comment) {
+      splitTokens(text, first + 1, &line.tokens);
+    } else {
+      splitTokens(text.substr(0, text.find('#')), first, &line.tokens);
+    }
+    return on_line(line, error);
+  });
+}
+
+Status readTextLines(const std::string& path, std::vector<TextLine>* out, uint64_t max_bytes) {
+  out->clear();
+  return forEachTextLine(
+      path,
+      [out](const TextLine& line, Status*) {
+        out->push_back(line);
+        return true;
+      },
+      max_bytes);
 }
 
 bool parseDouble(const std::string& token, double* value) {

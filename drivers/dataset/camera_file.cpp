@@ -42,7 +42,7 @@ std::map<std::string, CameraKey> cameraKeys(PinholeCamera* c) {
 
 Status readCameraFile(const std::string& path, PinholeCamera* out) {
   std::vector<TextLine> lines;
-  PLUMB_RETURN_IF_ERROR(readTextLines(path, &lines).withContext("camera file"));
+  PLUMB_RETURN_IF_ERROR(readTextLines(path, &lines, kMaxCameraFileBytes).withContext("camera file"));
   PinholeCamera camera;  // defaults: no distortion, 640x480, depth factor 5000, baseline 0.08
   const std::map<std::string, CameraKey> keys = cameraKeys(&camera);
   std::map<std::string, int> seen_on_line;

@@ -1,8 +1,8 @@
 #include "drivers/dataset/camera_presets.h"
 
-#include <fstream>
 
 #include "drivers/dataset/camera_file.h"
+#include "platform/input_file.h"
 
 namespace plumb {
 namespace {
@@ -62,9 +62,10 @@ Status cameraFromSpec(const std::string& preset_or_file, PinholeCamera* out) {
   if (isCameraPresetName(preset_or_file)) {
     PLUMB_RETURN_IF_ERROR(cameraPreset(preset_or_file, &camera));
   } else {
-    if (!std::ifstream(preset_or_file).good())
+    // stat(), not open(): a FIFO must not block here; readCameraFile says what is wrong with it.
+    if (pathKind(preset_or_file) == PathKind::kMissing)
       return Status::Error("camera '" + preset_or_file +
-                           "' is neither a preset (tum1 tum2 tum3 icl) nor a readable camera file");
+                           "' is neither a preset (tum1 tum2 tum3 icl) nor an existing camera file");
     PLUMB_RETURN_IF_ERROR(readCameraFile(preset_or_file, &camera));
   }
   const std::string problem = camera.validate();

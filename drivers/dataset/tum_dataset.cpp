@@ -13,11 +13,13 @@
 #include "drivers/dataset/png_decoder.h"
 #include "drivers/dataset/tum_lists.h"
 #include "drivers/image/jpeg_decoder.h"
+#include "platform/input_file.h"
 
 namespace plumb {
 namespace {
 
-bool fileExists(const std::string& path) { return std::ifstream(path).good(); }
+// stat(), never open(): a FIFO named like a list must not block the open (platform/input_file.h).
+bool fileExists(const std::string& path) { return pathKind(path) != PathKind::kMissing; }
 
 std::string typeName(int type) {
   const int depth = CV_MAT_DEPTH(type);
@@ -41,6 +43,10 @@ std::string imageProblem(int type, int width, int height, bool is_depth, const P
   return "";
 }
 
+// An image file larger than this is not a frame of an 8192-pixel camera (16-bit, uncompressed,
+// with room for a PNG's worst-case overhead).
+constexpr uint64_t kMaxImageFileBytes = uint64_t(kMaxImageSide) * kMaxImageSide * 4;
+
 int64_t monotonicNowNs() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(
              std::chrono::steady_clock::now().time_since_epoch())
@@ -51,14 +57,10 @@ int64_t monotonicNowNs() {
 // allocation per frame; POSIX read, because stdio's FILE allocates its buffer on every fopen).
 Status readFileBytes(const std::string& path, std::unique_ptr<unsigned char[]>* bytes, std::size_t* capacity,
                      std::size_t* size) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return Status::Error(path + ": missing or unreadable image file");
-  struct stat st {};
-  if (::fstat(fd, &st) != 0) {
-    ::close(fd);
-    return Status::Error(path + ": read error");
-  }
-  const auto expected = static_cast<std::size_t>(st.st_size);
+  InputFile file;
+  PLUMB_RETURN_IF_ERROR(file.open(path, kMaxImageFileBytes, "image file"));
+  const int fd = file.fd();
+  const auto expected = static_cast<std::size_t>(file.size());
   // 50 % headroom: file sizes vary from frame to frame; growing to exactly the largest so far
   // would reallocate whenever a later frame beats it.
   if (*capacity < expected) {
@@ -74,7 +76,7 @@ Status readFileBytes(const std::string& path, std::unique_ptr<unsigned char[]>* 
     if (n <= 0) break;  // error, or the file shrank meanwhile (a truncated image: the decoder says so)
     got += static_cast<std::size_t>(n);
   }
-  ::close(fd);
+  file.close();
   if (failed) return Status::Error(path + ": read error");
   if (got == 0) return Status::Error(path + ": empty image file");
   *size = got;
@@ -87,7 +89,7 @@ TumDatasetSource::TumDatasetSource() = default;
 TumDatasetSource::~TumDatasetSource() = default;
 
 Status TumDatasetSource::open(const std::string& dir, const PinholeCamera& camera,
-                              std::unique_ptr<TumDatasetSource>* out) {
+                              std::unique_ptr<TumDatasetSource>* out, std::size_t max_frames) {
   const std::string problem = camera.validate();
   if (!problem.empty()) return Status::Error("camera for " + dir + ": " + problem);
   std::unique_ptr<TumDatasetSource> source(new TumDatasetSource());
@@ -95,7 +97,7 @@ Status TumDatasetSource::open(const std::string& dir, const PinholeCamera& camer
   source->camera_ = camera;
   const std::string associations = dir + "/associations.txt";
   if (fileExists(associations)) {
-    PLUMB_RETURN_IF_ERROR(readTumAssociations(associations, &source->frames_));
+    PLUMB_RETURN_IF_ERROR(readTumAssociations(associations, &source->frames_, max_frames));
     source->used_associations_file_ = true;
   } else {
     const std::string rgb_list = dir + "/rgb.txt", depth_list = dir + "/depth.txt";
@@ -107,13 +109,20 @@ Status TumDatasetSource::open(const std::string& dir, const PinholeCamera& camer
     source->frames_ = associateTumLists(rgb, depth);
     if (source->frames_.empty())
       return Status::Error(dir + ": no rgb.txt/depth.txt pair within 0.02 s of each other");
+    if (max_frames > 0 && source->frames_.size() > max_frames) source->frames_.resize(max_frames);
   }
   // Fail fast: a missing image is reported at open, not minutes into a run.
   const std::string lists = source->used_associations_file_ ? "associations.txt" : "rgb.txt/depth.txt";
   for (const TumFrameEntry& frame : source->frames_) {
     for (const std::string* relative : {&frame.rgb_path, &frame.depth_path}) {
-      if (!fileExists(dir + "/" + *relative))
-        return Status::Error(dir + "/" + *relative + ": missing image file (listed in " + lists + ")");
+      // Missing, a symlink loop, a FIFO: the reason, not a guess.
+      const std::string path = dir + "/" + *relative;
+      const Status present = requireRegularFile(path, "");
+      if (!present.ok()) {
+        if (pathKind(path) == PathKind::kMissing)
+          return Status::Error(path + ": missing image file (listed in " + lists + ")");
+        return Status::Error(present.message() + " (an image file listed in " + lists + ")");
+      }
     }
     // Full paths once, so loading a frame builds no strings.
     source->rgb_files_.push_back(dir + "/" + frame.rgb_path);

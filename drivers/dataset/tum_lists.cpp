@@ -5,6 +5,7 @@
 
 #include "drivers/common/text_lines.h"
 #include "drivers/common/timestamp_association.h"
+#include "sensor/rgbd_image.h"
 
 namespace plumb {
 namespace {
@@ -19,6 +20,9 @@ Status parseStamp(const std::string& where, const std::string& token, double* t)
   if (!parseDouble(token, t)) return Status::Error(where + ": '" + token + "' is not a timestamp");
   if (!std::isfinite(*t) || *t < 0)
     return Status::Error(where + ": timestamp '" + token + "' is not a finite non-negative number");
+  if (*t > kMaxTimestampS)
+    return Status::Error(where + ": timestamp '" + token + "' is beyond 1e10 s (the year 2286): seconds are expected, "
+                         "not nanoseconds or microseconds");
   return Status::Ok();
 }
 
@@ -53,6 +57,34 @@ Status checkEntryPath(const std::string& where, const std::string& path) {
   return Status::Ok();
 }
 
+// One line of associations.txt appended to *out, checked against the previous entry.
+Status parseAssociation(const std::string& list_path, const TextLine& line, int previous_line,
+                        std::vector<TumFrameEntry>* out) {
+  const std::string where = fileLine(list_path, line.number);
+  if (line.tokens.size() != 4)
+    return Status::Error(where + ": expected `t_rgb rgb_file t_depth depth_file`, got " +
+                         std::to_string(line.tokens.size()) + " fields");
+  // The benchmark writes rgb first; some tools (and ICL-NUIM's TUM-format release) write
+  // depth first. The folder names of the paths say which column is which.
+  const bool depth_first = startsWith(line.tokens[1], "depth") && startsWith(line.tokens[3], "rgb");
+  const int rgb_column = depth_first ? 2 : 0, depth_column = depth_first ? 0 : 2;
+  TumFrameEntry entry;
+  PLUMB_RETURN_IF_ERROR(parseStamp(where, line.tokens[rgb_column], &entry.rgb_timestamp_s));
+  entry.rgb_path = line.tokens[rgb_column + 1];
+  PLUMB_RETURN_IF_ERROR(parseStamp(where, line.tokens[depth_column], &entry.depth_timestamp_s));
+  entry.depth_path = line.tokens[depth_column + 1];
+  PLUMB_RETURN_IF_ERROR(checkEntryPath(where, entry.rgb_path));
+  PLUMB_RETURN_IF_ERROR(checkEntryPath(where, entry.depth_path));
+  if (!out->empty()) {
+    PLUMB_RETURN_IF_ERROR(
+        checkIncreasing(where, "rgb", out->back().rgb_timestamp_s, previous_line, entry.rgb_timestamp_s));
+    PLUMB_RETURN_IF_ERROR(
+        checkIncreasing(where, "depth", out->back().depth_timestamp_s, previous_line, entry.depth_timestamp_s));
+  }
+  out->push_back(std::move(entry));
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status readTumImageList(const std::string& list_path, std::vector<TumListEntry>* out) {
@@ -79,37 +111,15 @@ Status readTumImageList(const std::string& list_path, std::vector<TumListEntry>*
   return Status::Ok();
 }
 
-Status readTumAssociations(const std::string& list_path, std::vector<TumFrameEntry>* out) {
+Status readTumAssociations(const std::string& list_path, std::vector<TumFrameEntry>* out, std::size_t max_entries) {
   out->clear();
-  std::vector<TextLine> lines;
-  PLUMB_RETURN_IF_ERROR(readTextLines(list_path, &lines));
   int previous_line = 0;
-  for (const TextLine& line : lines) {
-    if (line.is_comment) continue;
-    const std::string where = fileLine(list_path, line.number);
-    if (line.tokens.size() != 4)
-      return Status::Error(where + ": expected `t_rgb rgb_file t_depth depth_file`, got " +
-                           std::to_string(line.tokens.size()) + " fields");
-    // The benchmark writes rgb first; some tools (and ICL-NUIM's TUM-format release) write
-    // depth first. The folder names of the paths say which column is which.
-    const bool depth_first = startsWith(line.tokens[1], "depth") && startsWith(line.tokens[3], "rgb");
-    const int rgb_column = depth_first ? 2 : 0, depth_column = depth_first ? 0 : 2;
-    TumFrameEntry entry;
-    PLUMB_RETURN_IF_ERROR(parseStamp(where, line.tokens[rgb_column], &entry.rgb_timestamp_s));
-    entry.rgb_path = line.tokens[rgb_column + 1];
-    PLUMB_RETURN_IF_ERROR(parseStamp(where, line.tokens[depth_column], &entry.depth_timestamp_s));
-    entry.depth_path = line.tokens[depth_column + 1];
-    PLUMB_RETURN_IF_ERROR(checkEntryPath(where, entry.rgb_path));
-    PLUMB_RETURN_IF_ERROR(checkEntryPath(where, entry.depth_path));
-    if (!out->empty()) {
-      PLUMB_RETURN_IF_ERROR(
-          checkIncreasing(where, "rgb", out->back().rgb_timestamp_s, previous_line, entry.rgb_timestamp_s));
-      PLUMB_RETURN_IF_ERROR(checkIncreasing(where, "depth", out->back().depth_timestamp_s, previous_line,
-                                            entry.depth_timestamp_s));
-    }
+  PLUMB_RETURN_IF_ERROR(forEachTextLine(list_path, [&](const TextLine& line, Status* error) {
+    if (line.is_comment) return true;
+    *error = parseAssociation(list_path, line, previous_line, out);
     previous_line = line.number;
-    out->push_back(std::move(entry));
-  }
+    return error->ok() && (max_entries == 0 || out->size() < max_entries);
+  }));
   if (out->empty()) return Status::Error(list_path + ": empty list (no associations)");
   return Status::Ok();
 }

@@ -19,7 +19,9 @@ struct TumListEntry {
 
 Status readTumImageList(const std::string& list_path, std::vector<TumListEntry>* out);
 
-Status readTumAssociations(const std::string& list_path, std::vector<TumFrameEntry>* out);
+// max_entries > 0: stop after that many associations (the rest of the file is not read).
+Status readTumAssociations(const std::string& list_path, std::vector<TumFrameEntry>* out,
+                           std::size_t max_entries = 0);
 
 // Pairs rgb and depth lists with the benchmark's rule (timestamp_association.h).
 std::vector<TumFrameEntry> associateTumLists(const std::vector<TumListEntry>& rgb,

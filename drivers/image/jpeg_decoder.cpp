@@ -24,6 +24,7 @@ struct ErrorManager {
   jpeg_error_mgr base;
   std::jmp_buf jump;
   char message[JMSG_LENGTH_MAX];
+  char warning[JMSG_LENGTH_MAX];  // the first warning (a truncated or corrupt stream)
 };
 
 void onError(j_common_ptr info) {
@@ -31,7 +32,16 @@ void onError(j_common_ptr info) {
   (*info->err->format_message)(info, errors->message);
   std::longjmp(errors->jump, 1);
 }
-void onMessage(j_common_ptr) {}  // warnings (corrupt-data remarks) are not printed
+void onMessage(j_common_ptr) {}  // nothing is printed: problems become the decoder's error
+// libjpeg only WARNS about a truncated stream ("Premature end of JPEG file") or corrupt data, and
+// fills the missing rows with grey: a silently wrong image (a truncated PNG is refused). Every
+// warning is kept and fails the decode, like an error.
+void onEmit(j_common_ptr info, int level) {
+  if (level >= 0) return;  // trace messages
+  auto* errors = reinterpret_cast<ErrorManager*>(info->err);
+  if (errors->warning[0] == '\0') (*info->err->format_message)(info, errors->warning);
+  ++info->err->num_warnings;
+}
 
 // The libjpeg calls, apart so that setjmp's frame holds no objects with destructors. The Mat is
 // created inside, after the header is known.
@@ -40,6 +50,7 @@ bool decodeRows(const uint8_t* bytes, std::size_t size, cv::Mat& dst, ErrorManag
   info.err = jpeg_std_error(&errors.base);
   errors.base.error_exit = onError;
   errors.base.output_message = onMessage;
+  errors.base.emit_message = onEmit;
   if (setjmp(errors.jump)) {
     jpeg_destroy_decompress(&info);
     return false;
@@ -68,8 +79,10 @@ bool decodeRows(const uint8_t* bytes, std::size_t size, cv::Mat& dst, ErrorManag
   }
 #endif
   jpeg_finish_decompress(&info);
+  const bool clean = errors.base.num_warnings == 0;
   jpeg_destroy_decompress(&info);
-  return true;
+  if (!clean) std::snprintf(errors.message, sizeof errors.message, "%s", errors.warning);
+  return clean;
 }
 
 }  // namespace
@@ -83,6 +96,7 @@ bool decodeJpeg(const uint8_t* bytes, std::size_t size, cv::Mat& dst, std::strin
   }
   ErrorManager errors;
   errors.message[0] = '\0';
+  errors.warning[0] = '\0';
   if (!decodeRows(bytes, size, dst, errors)) {
     if (error) *error = std::string("corrupt or truncated JPEG (") + errors.message + ")";
     return false;

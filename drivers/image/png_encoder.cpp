@@ -1,5 +1,7 @@
 #include "drivers/image/png_encoder.h"
 
+#include "drivers/common/atomic_file.h"
+
 #include <png.h>
 
 #include <csetjmp>
@@ -85,6 +87,13 @@ Status encodePng(const cv::Mat& image, const PngEncodeOptions& options, std::vec
     return Status::Error(std::string("PNG encoder: ") + context.error);
   }
   return Status::Ok();
+}
+
+Status writePngOutput(const std::string& path, const cv::Mat& image, const PngEncodeOptions& options) {
+  std::vector<uint8_t> bytes;
+  const Status encoded = encodePng(image, options, bytes);
+  if (!encoded.ok()) return Status::Error(path + ": " + encoded.message());
+  return writeFileAtomically(path, bytes.data(), bytes.size());
 }
 
 Status writePngFile(const std::string& path, const cv::Mat& image, const PngEncodeOptions& options) {

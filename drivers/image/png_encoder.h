@@ -43,5 +43,9 @@ Status encodePng(const cv::Mat& image, const PngEncodeOptions& options, std::vec
 
 // Encodes `image` and writes it to `path` (replaced if present).
 Status writePngFile(const std::string& path, const cv::Mat& image, const PngEncodeOptions& options);
+// A command's output image (`eval --plot`, `profile --png`): written through AtomicFile
+// (drivers/common/atomic_file.h), so it appears only when complete, through a symlink to its
+// target. writePngFile above writes in place: for the many images of a new dataset folder.
+Status writePngOutput(const std::string& path, const cv::Mat& image, const PngEncodeOptions& options);
 
 }  // namespace plumb

@@ -2,6 +2,7 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -9,6 +10,7 @@
 #include "drivers/common/atomic_file.h"
 #include "drivers/recording/byte_io.h"
 #include "drivers/recording/crc32.h"
+#include "platform/input_file.h"
 
 namespace plumb {
 
@@ -47,9 +49,11 @@ std::vector<uint8_t> encodeMapFile(uint32_t version, const std::vector<MapFileSe
   return out;
 }
 
-Status parseMapFile(const uint8_t* data, std::size_t size, uint32_t supported_version, const MapFileLimits& limits,
-                    std::vector<MapFileSection>* sections) {
-  sections->clear();
+namespace {
+
+// The 32-byte header: magic, CRC, version, reserved, the file size within the limit.
+Status checkMapHeader(const uint8_t* data, std::size_t size, uint32_t supported_version, const MapFileLimits& limits,
+                      uint64_t* file_size, uint32_t* count) {
   if (size < kMapFileHeaderBytes) {
     return Status::Error("not a plumb map: " + std::to_string(size) + " bytes, shorter than the " +
                          std::to_string(kMapFileHeaderBytes) + "-byte header (truncated?)");
@@ -57,8 +61,8 @@ Status parseMapFile(const uint8_t* data, std::size_t size, uint32_t supported_ve
   if (std::memcmp(data, kMagic, sizeof kMagic) != 0) return Status::Error("not a plumb map (wrong magic)");
   ByteReader header(data + sizeof kMagic, kMapFileHeaderBytes - sizeof kMagic);
   const uint32_t version = header.u32();
-  const uint32_t count = header.u32();
-  const uint64_t file_size = header.u64();
+  *count = header.u32();
+  *file_size = header.u64();
   const uint32_t reserved = header.u32();
   const uint32_t header_crc = header.u32();
   if (crc32(data, kMapFileHeaderBytes - 4) != header_crc) {
@@ -73,10 +77,21 @@ Status parseMapFile(const uint8_t* data, std::size_t size, uint32_t supported_ve
                          std::to_string(supported_version) + ")");
   }
   if (reserved != 0) return Status::Error("map header: reserved field is not 0");
-  if (file_size > limits.max_file_bytes) {
-    return Status::Error("map header says " + std::to_string(file_size) + " bytes, beyond the limit of " +
+  if (*file_size > limits.max_file_bytes) {
+    return Status::Error("map header says " + std::to_string(*file_size) + " bytes, beyond the limit of " +
                          std::to_string(limits.max_file_bytes));
   }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status parseMapFile(const uint8_t* data, std::size_t size, uint32_t supported_version, const MapFileLimits& limits,
+                    std::vector<MapFileSection>* sections) {
+  sections->clear();
+  uint64_t file_size = 0;
+  uint32_t count = 0;
+  PLUMB_RETURN_IF_ERROR(checkMapHeader(data, size, supported_version, limits, &file_size, &count));
   if (file_size != size) {
     return Status::Error("map is " + std::to_string(size) + " bytes but its header says " + std::to_string(file_size) +
                          (size < file_size ? " (truncated)" : " (bytes after the end)"));
@@ -119,22 +134,22 @@ Status parseMapFile(const uint8_t* data, std::size_t size, uint32_t supported_ve
 
 Status readMapFile(const std::string& path, uint32_t supported_version, const MapFileLimits& limits,
                    std::vector<MapFileSection>* sections) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (f == nullptr) return Status::Error("cannot open map " + path + ": " + std::strerror(errno));
-  struct stat st {};
-  if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
-    std::fclose(f);
-    return Status::Error("map " + path + " is not a regular file");
+  // Opened the one way (platform/input_file.h): a FIFO or device is refused without blocking, the
+  // size is bounded before reading, and the header (magic, CRC, version, size) is checked before
+  // the rest of the file is read: a foreign 900 MB file costs 32 bytes of reading.
+  InputFile file;
+  PLUMB_RETURN_IF_ERROR(file.open(path, limits.max_file_bytes, "map"));
+  std::vector<uint8_t> bytes(std::size_t(std::min<uint64_t>(file.size(), kMapFileHeaderBytes)));
+  if (!bytes.empty() && !file.readExactly(bytes.data(), bytes.size())) return Status::Error("map " + path + ": read error");
+  if (file.size() > kMapFileHeaderBytes) {
+    uint64_t file_size = 0;
+    uint32_t count = 0;
+    PLUMB_RETURN_IF_ERROR(
+        checkMapHeader(bytes.data(), bytes.size(), supported_version, limits, &file_size, &count).withContext("map " + path));
+    bytes.resize(std::size_t(file.size()));
+    if (!file.readExactly(bytes.data() + kMapFileHeaderBytes, bytes.size() - kMapFileHeaderBytes))
+      return Status::Error("map " + path + ": read error");
   }
-  if (uint64_t(st.st_size) > limits.max_file_bytes) {
-    std::fclose(f);
-    return Status::Error("map " + path + " is " + std::to_string(st.st_size) + " bytes, beyond the limit of " +
-                         std::to_string(limits.max_file_bytes));
-  }
-  std::vector<uint8_t> bytes(std::size_t(st.st_size));
-  const std::size_t got = bytes.empty() ? 0 : std::fread(bytes.data(), 1, bytes.size(), f);
-  std::fclose(f);
-  if (got != bytes.size()) return Status::Error("map " + path + ": read error");
   return parseMapFile(bytes.data(), bytes.size(), supported_version, limits, sections).withContext("map " + path);
 }
 

@@ -50,6 +50,13 @@ Status parseMavlinkEndpoint(const std::string& spec, MavlinkEndpoint* out) {
     const std::string host = rest.substr(0, last);
     if (host.empty()) return endpointError(spec, "empty host");
     if (host.find(':') != std::string::npos) {
+      // HOST:PORT:more is a spec with extra fields, not an IPv6 address: say which.
+      const std::size_t first = rest.find(':');
+      const std::size_t second = rest.find(':', first + 1);
+      long port_value = 0;
+      if (parseInteger(rest.substr(first + 1, second - first - 1), 1, 65535, &port_value)) {
+        return endpointError(spec, "unexpected field '" + rest.substr(second + 1) + "' after udp:HOST:PORT");
+      }
       return endpointError(spec, "IPv6 addresses are not supported, use an IPv4 address");
     }
     long port = 0;

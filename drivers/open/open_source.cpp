@@ -1,13 +1,13 @@
 #include "drivers/open/open_source.h"
 
 #include <cctype>
-#include <fstream>
 
 #include "drivers/common/text_lines.h"
 #include "drivers/dataset/camera_presets.h"
 #include "drivers/dataset/tum_dataset.h"
 #include "drivers/open/sensor_source_specs.h"
 #include "drivers/synth/synth_spec.h"
+#include "platform/input_file.h"
 
 namespace plumb {
 namespace {
@@ -45,6 +45,11 @@ Status openSynthetic(const std::string& spec, const std::string& camera_spec,
 
 Status openFrameSource(const std::string& spec, const std::string& camera_spec,
                        std::unique_ptr<FrameSource>* out) {
+  return openFrameSource(spec, camera_spec, SourceOpenOptions{}, out);
+}
+
+Status openFrameSource(const std::string& spec, const std::string& camera_spec, const SourceOpenOptions& options,
+                       std::unique_ptr<FrameSource>* out) {
   if (spec.empty()) return Status::Error("empty source specification");
   if (isSynthSpec(spec)) return openSynthetic(spec, camera_spec, out);
   if (isSensorOrRecordingSpec(spec)) return openSensorOrRecordingSource(spec, camera_spec, out);
@@ -54,7 +59,8 @@ Status openFrameSource(const std::string& spec, const std::string& camera_spec,
   std::string camera_choice = camera_spec;
   if (camera_choice.empty()) {
     const std::string folder_camera = spec + "/camera.txt";
-    camera_choice = std::ifstream(folder_camera).good() ? folder_camera : cameraPresetFromFolderName(spec);
+    // Present in any form (a FIFO too: the camera reader then refuses it) wins over the name.
+    camera_choice = pathKind(folder_camera) != PathKind::kMissing ? folder_camera : cameraPresetFromFolderName(spec);
   }
   if (camera_choice.empty())
     return Status::Error(spec +
@@ -63,7 +69,7 @@ Status openFrameSource(const std::string& spec, const std::string& camera_spec,
   PinholeCamera camera;
   PLUMB_RETURN_IF_ERROR(cameraFromSpec(camera_choice, &camera));
   std::unique_ptr<TumDatasetSource> source;
-  PLUMB_RETURN_IF_ERROR(TumDatasetSource::open(spec, camera, &source));
+  PLUMB_RETURN_IF_ERROR(TumDatasetSource::open(spec, camera, &source, options.max_frames));
   *out = std::move(source);
   return Status::Ok();
 }

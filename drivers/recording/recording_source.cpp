@@ -1,5 +1,7 @@
 #include "drivers/recording/recording_source.h"
 
+#include <unistd.h>
+
 #include <cmath>
 
 #include <algorithm>
@@ -9,6 +11,7 @@
 
 #include "drivers/recording/byte_io.h"
 #include "drivers/recording/frame_codec.h"
+#include "platform/input_file.h"
 
 namespace plumb {
 namespace {
@@ -22,8 +25,15 @@ int64_t monotonicNowNs() {
 }
 
 Status openFile(const std::string& path, std::FILE** file, uint64_t* size) {
-  *file = std::fopen(path.c_str(), "rb");
-  if (!*file) return Status::Error(path + ": cannot open: " + std::strerror(errno));
+  // Opened the one way (platform/input_file.h): a FIFO or a device is refused, never blocks.
+  InputFile input;
+  PLUMB_RETURN_IF_ERROR(input.open(path, UINT64_MAX, "recording"));
+  const int fd = ::dup(input.fd());
+  *file = fd >= 0 ? ::fdopen(fd, "rb") : nullptr;
+  if (!*file) {
+    if (fd >= 0) ::close(fd);
+    return Status::Error(path + ": cannot open: " + std::strerror(errno));
+  }
   if (fseeko(*file, 0, SEEK_END) != 0) return Status::Error(path + ": cannot seek");
   *size = static_cast<uint64_t>(ftello(*file));
   return Status::Ok();
@@ -166,7 +176,7 @@ SourceResult RecordingSource::next(RgbdImage& out) {
       // CRC held, so the bytes are as written: a foreign or buggy writer. Skip and say so.
       ++stats_.chunks_skipped;
       stats_.bytes_skipped += chunk_size;
-      stats_.last_damage = "chunk at byte " + std::to_string(pos_) + ": undecodable frame (bad image, size or timestamp)";
+      stats_.last_damage = "chunk at byte " + std::to_string(pos_) + ": undecodable frame (bad image, size, timestamp or depth factor)";
       pos_ += chunk_size;
       continue;
     }
@@ -182,10 +192,16 @@ bool RecordingSource::decodeFrame(const FrameChunkInfo& info, const uint8_t* ima
   if (info.width != camera_.width || info.height != camera_.height) return false;
   // Time must be a number and move forward: a NaN, backwards or repeated timestamp (CRC intact, so
   // a foreign or buggy writer) would put a wrong line into every trajectory made from this file.
-  if (!std::isfinite(info.timestamp_s) || !std::isfinite(info.depth_timestamp_s) ||
+  // An absurd stamp (1e300, nanoseconds) is damage itself; it never becomes the reference that
+  // would make every later, correct frame look like a step back in time.
+  auto plausible = [](double t) { return std::isfinite(t) && t >= 0 && t <= kMaxTimestampS; };
+  if (!plausible(info.timestamp_s) || !plausible(info.depth_timestamp_s) ||
       (has_last_timestamp_ && !(info.timestamp_s > last_timestamp_s_))) {
     return false;
   }
+  // The depth scale of the frame must be a camera's (sensor/camera.h bounds), never 0 or NaN.
+  if (!(info.depth_factor >= kCameraBounds.min_depth_factor && info.depth_factor <= kCameraBounds.max_depth_factor))
+    return false;
   if (!decodeColour(images, info.colour_size, info.colour_codec, info.width, info.height, out.bgr))
     return false;
   if (!decodeDepth(images + info.colour_size, info.depth_size, info.depth_codec, info.width,

@@ -29,6 +29,7 @@ class CovarianceWriter {
   Status open(const std::string& path);
   Status append(const StampedCovariance& keyframe);  // allocates nothing
   Status close();
+  void abandon() { file_.abandon(); }  // nothing appears under the name (an older file stays)
 
  private:
   std::string path_;

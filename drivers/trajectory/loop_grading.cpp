@@ -2,11 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include <Eigen/Cholesky>
 
+#include "platform/input_file.h"
 #include "runtime/json_reader.h"
 #include "solver/se3.h"
 
@@ -73,12 +72,10 @@ double viewAngleDeg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
 }  // namespace
 
 Status readLoopAudit(const std::string& stats_path, LoopAuditFile* out) {
-  std::ifstream in(stats_path, std::ios::binary);
-  if (!in) return Status::Error("cannot open " + stats_path);
-  std::stringstream text;
-  text << in.rdbuf();
+  std::string text;
+  PLUMB_RETURN_IF_ERROR(readInputFile(stats_path, kMaxTextInputBytes, "statistics file", &text));
   runtime::JsonValue root;
-  Status st = runtime::parseJson(text.str(), &root);
+  Status st = runtime::parseJson(text, &root);
   if (!st.ok()) return st.withContext("reading " + stats_path);
   const runtime::JsonValue* audit = root.find("loop_audit");
   if (audit == nullptr || audit->type != runtime::JsonValue::Type::kObject) {

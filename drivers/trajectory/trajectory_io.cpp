@@ -58,27 +58,29 @@ Status readTumTrajectory(const std::string& path, std::vector<StampedPose>* out,
                          const TrajectoryReadOptions& options, TrajectoryReadReport* report) {
   out->clear();
   TrajectoryReadReport local_report;
-  std::vector<TextLine> lines;
-  PLUMB_RETURN_IF_ERROR(readTextLines(path, &lines));
   int previous_line = 0;
   std::size_t valid_poses = 0;
-  for (const TextLine& line : lines) {
+  // Streamed (drivers/common/text_lines.h): memory holds the poses, never the file's text.
+  PLUMB_RETURN_IF_ERROR(forEachTextLine(path, [&](const TextLine& line, Status* error) {
     const std::string where = fileLine(path, line.number);
     StampedPose pose;
     if (line.is_comment) {
-      if (!parseLostMarker(line, &pose.timestamp, &pose.dropped) || !options.keep_lost_markers) continue;
+      if (!parseLostMarker(line, &pose.timestamp, &pose.dropped) || !options.keep_lost_markers) return true;
       pose.valid = false;
     } else {
       bool normalised = false;
-      PLUMB_RETURN_IF_ERROR(parsePoseLine(where, line, options, &pose, &normalised));
+      *error = parsePoseLine(where, line, options, &pose, &normalised);
+      if (!error->ok()) return false;
       local_report.quaternions_normalised += normalised ? 1 : 0;
     }
     if (!out->empty()) {
       const double previous = out->back().timestamp;
-      if (pose.timestamp < previous)
-        return Status::Error(where + ": non-monotonic timestamp " + formatNumber("%.6f", pose.timestamp) +
-                             " (previous " + formatNumber("%.6f", previous) + " on line " +
-                             std::to_string(previous_line) + ")");
+      if (pose.timestamp < previous) {
+        *error = Status::Error(where + ": non-monotonic timestamp " + formatNumber("%.6f", pose.timestamp) +
+                               " (previous " + formatNumber("%.6f", previous) + " on line " +
+                               std::to_string(previous_line) + ")");
+        return false;
+      }
       if (pose.timestamp == previous) {
         // The benchmark's dictionary keeps the later line; so do we, and count it.
         ++local_report.duplicate_timestamps_replaced;
@@ -89,7 +91,8 @@ Status readTumTrajectory(const std::string& path, std::vector<StampedPose>* out,
     valid_poses += pose.valid ? 1 : 0;
     previous_line = line.number;
     out->push_back(pose);
-  }
+    return true;
+  }));
   if (valid_poses == 0) return Status::Error(path + ": no poses (empty trajectory)");
   if (report) *report = local_report;
   return Status::Ok();

@@ -62,6 +62,7 @@ class TumTrajectoryWriter {
   Status open(const std::string& path);
   Status append(const StampedPose& pose);  // allocates nothing
   Status close();
+  void abandon() { file_.abandon(); }  // nothing appears under the name (an older file stays)
 
  private:
   std::string path_;

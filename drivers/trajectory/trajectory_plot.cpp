@@ -216,7 +216,7 @@ Status writeTrajectoryPlot(const std::string& png_path, const AteResult& ate,
   errors.area = cv::Rect(left, error_top, usable_width, error_height);
   drawErrorsOverTime(image, errors, ate);
 
-  const Status written = writePngFile(png_path, image, pngFastestOptions());
+  const Status written = writePngOutput(png_path, image, pngFastestOptions());
   if (!written.ok()) return Status::Error("cannot write plot: " + written.message());
   return Status::Ok();
 }

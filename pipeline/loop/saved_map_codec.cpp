@@ -243,6 +243,12 @@ Status decodeKeyframes(const std::vector<uint8_t>& bytes, const SavedMapLimits& 
   for (std::size_t i = 0; i < n && d.ok(); ++i) {
     auto k = std::make_unique<SavedKeyframe>();
     decodeKeyframe(d, k.get());
+    // The run that loads the map numbers its new keyframes after the largest loaded id: an id near
+    // 2^32 would wrap them to small ids that never join the loop closer (and vanish on re-save).
+    if (d.ok() && k->record.id > kMaxSavedKeyframeId) {
+      d.fail("keyframe id " + std::to_string(k->record.id) + " beyond " + std::to_string(kMaxSavedKeyframeId) +
+             " (ids must leave room for the keyframes of the runs that load the map)");
+    }
     if (d.ok() && k->record.id <= previous_id) {
       d.fail("keyframe ids are not strictly ascending (" + std::to_string(k->record.id) + " after " +
              std::to_string(previous_id) + ")");

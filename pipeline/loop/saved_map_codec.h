@@ -31,6 +31,9 @@
 namespace plumb::loop {
 
 constexpr uint32_t kSavedMapFormatVersion = 1;
+// The largest keyframe id a map may hold (2^31 - 1): a run that loads it numbers new keyframes
+// after it, so 2^31 ids stay free (68 years at one keyframe a second) and ids never wrap.
+constexpr uint32_t kMaxSavedKeyframeId = 0x7FFFFFFFu;
 
 constexpr uint32_t sectionTag(char a, char b, char c, char d) {
   return uint32_t(uint8_t(a)) | uint32_t(uint8_t(b)) << 8 | uint32_t(uint8_t(c)) << 16 | uint32_t(uint8_t(d)) << 24;

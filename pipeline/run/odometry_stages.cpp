@@ -25,6 +25,13 @@ bool CaptureStage::peekNext(int64_t* t_recorded_ns) {
   return capture_.prepareNext(t_recorded_ns) || ended();
 }
 
+bool CaptureStage::stopRequested() {
+  if (stopped_ || stop_ == nullptr || !stop_->load(std::memory_order_relaxed)) return stopped_;
+  stopped_ = true;
+  ended();  // the runner reads no more: the input has ended here, as in peekNext
+  return true;
+}
+
 Status CaptureStage::read(OdometrySlot& slot, const runtime::FrameStamps& stamps) {
   ++consumed_;
   PLUMB_RETURN_IF_ERROR(capture_.take(slot.image));

@@ -51,6 +51,7 @@ class CaptureStage final : public runtime::Source<OdometrySlot> {
   bool peekNext(int64_t* t_recorded_ns) override;
   Status read(OdometrySlot& slot, const runtime::FrameStamps& stamps) override;
   void skip() override;
+  bool stopRequested() override;
   bool stopped() const { return stopped_; }
 
  private:

@@ -95,6 +95,13 @@ std::string runSummaryJson(const RunSummary& r) {
                     o.tracker.use_lines ? "true" : "false", o.extractor.min_line_inliers, o.extractor.num_features,
                     o.extractor.num_levels, o.extractor.max_lines, o.mapper.ba_optimised_keyframes,
                     o.mapper.ba_iterations));
+  if (!r.command_options.empty()) {
+    out += "  \"command_options\": {";
+    for (std::size_t i = 0; i < r.command_options.size(); ++i) {
+      out += (i ? ", " : "") + jsonString(r.command_options[i].first) + ": " + r.command_options[i].second;
+    }
+    out += "},\n";
+  }
   // Loop closing (docs/LOOP.md): graph size, loops found and rejected by reason, optimisation time.
   const LoopRunResult& lr = r.run->loop;
   if (!lr.enabled) {

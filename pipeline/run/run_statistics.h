@@ -5,6 +5,7 @@
 // and the options the run actually used. Formats JSON as a string; writing files is the caller's.
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pipeline/odometry/odometry_system.h"
@@ -53,6 +54,9 @@ struct RunSummary {
   MapperStats mapper;
   SystemOptions system_options;
   OdometryRunOptions run_options;
+  // The command line's options root (`plumb run`: every flag, given or default) as name -> JSON
+  // value text, written as "command_options" when not empty.
+  std::vector<std::pair<std::string, std::string>> command_options;
   double ate_rmse_m = -1;
   int stop_signal = 0;  // the signal that stopped the run early (0: it was not stopped by one)
   uint64_t damaged_regions = 0;  // input regions the source skipped as damaged

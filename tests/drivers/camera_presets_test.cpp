@@ -102,6 +102,8 @@ TEST(CameraFile, WriteReadRoundTripIsExact) {
   ASSERT_TRUE(cameraPreset("tum1", &camera).ok());
   camera.width = 320;
   camera.height = 240;
+  camera.cx = 159.25;  // inside the smaller image (a principal point off the image is refused)
+  camera.cy = 119.75;
   camera.baseline_m = 0.075;
   ASSERT_TRUE(writeCameraFile(dir.file("camera.txt"), camera).ok());
   PinholeCamera back;

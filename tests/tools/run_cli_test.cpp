@@ -52,6 +52,46 @@ TEST(RunOptionsValidation, MinLineInliersAboveSamplesIsRefused) {
   EXPECT_FALSE(validate(options).ok());
 }
 
+TEST(RunCli, StatsRecordEveryOptionOfTheCommandLine) {
+  ScratchDir dir("plumb_run_options");
+  ASSERT_TRUE(dir.ok());
+  const std::string stats = dir.file("s.json");
+  const RunResult r = runPlumb("run --dataset synth:textured:1:5 --discard-trajectory --output-delay 7 --no-loops "
+                               "--stats '" + stats + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(stats);
+  const std::string json((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t at = json.find("\"command_options\": {");
+  ASSERT_NE(at, std::string::npos) << json;
+  const std::string options = json.substr(at, json.find('}', at) - at);
+  // Given values, defaults and switches alike: every flag of `plumb run --help`.
+  for (const char* entry : {"\"dataset\": \"synth:textured:1:5\"", "\"output-delay\": 7", "\"no-loops\": true",
+                            "\"line-samples\": 5", "\"mode\": \"deterministic\"", "\"out\": null", "\"slots\": 8",
+                            "\"progress\": false", "\"skip-frames\": 0", "\"mlock\": false", "\"mavlink\": null"}) {
+    EXPECT_NE(options.find(entry), std::string::npos) << entry << " in " << options;
+  }
+  const RunResult help = runPlumb("run --help");
+  std::size_t flags = 0;
+  for (std::size_t p = help.output.find("\n  --"); p != std::string::npos; p = help.output.find("\n  --", p + 1)) ++flags;
+  std::size_t keys = 0;
+  for (std::size_t p = options.find("\": "); p != std::string::npos; p = options.find("\": ", p + 1)) ++keys;
+  EXPECT_EQ(keys, flags + 1) << options;  // + the "command_options" key itself
+}
+
+TEST(RunCli, ProgressLineHasFramesPerSecondAndEta) {
+  ScratchDir dir("plumb_run_progress");
+  ASSERT_TRUE(dir.ok());
+  // Not a terminal here: off by default, a line every 100 frames when asked.
+  const RunResult quiet = runPlumb("run --dataset synth:textured:1:100 --discard-trajectory --no-loops");
+  ASSERT_EQ(quiet.exit_code, 0) << quiet.output;
+  EXPECT_EQ(quiet.output.find("frames/s, ETA"), std::string::npos) << quiet.output;
+  const RunResult r = runPlumb("run --dataset synth:textured:1:100 --discard-trajectory --no-loops --progress");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("frame 100/100 (100%), "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(" frames/s, ETA 0:00: "), std::string::npos) << r.output;
+  EXPECT_EQ(runPlumb("run --dataset synth:textured:1:5 --discard-trajectory --progress --no-progress").exit_code, 2);
+}
+
 TEST(RunCli, OneLineSampleIsRefusedBeforeAnyOutput) {
   ScratchDir dir("plumb_run_cli");
   ASSERT_TRUE(dir.ok());
@@ -209,7 +249,11 @@ TEST(RunStop, SigintKeepsEveryComputedPoseAndSaysSo) {
   ASSERT_NE(at, std::string::npos) << json;
   ASSERT_EQ(std::sscanf(json.c_str() + at, "\"frames\": %llu", &frames), 1);
   // (On a slow machine, e.g. under ASan, the signal may come while the scene is still being built:
-  // then the run ends before its first frame, as cleanly.)
+  // then the run ends before its first frame, as cleanly, and replaces no trajectory file.)
+  if (frames == 0) {
+    EXPECT_FALSE(std::filesystem::exists(out)) << output;
+    return;
+  }
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), long(frames) + 1) << output;
   ASSERT_FALSE(text.empty());
   EXPECT_EQ(text.back(), '\n');
