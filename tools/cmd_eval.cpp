@@ -3,12 +3,14 @@
 #include <cstdio>
 #include <string>
 
+#include "drivers/synth/synth_spec.h"
 #include "drivers/trajectory/evaluate.h"
 #include "drivers/trajectory/trajectory_io.h"
 #include "drivers/trajectory/trajectory_plot.h"
 #include "runtime/json_text.h"
 #include "tools/args.h"
 #include "tools/command.h"
+#include "tools/eval_loops.h"
 #include "tools/eval_nees.h"
 #include "tools/io_plan.h"
 
@@ -19,7 +21,9 @@ void printEvalUsage() {
   std::printf(
       "usage: plumb eval --gt GT.txt --est EST.txt [--plot out.png] [--json]\n"
       "                  [--covariance COV --nees] [--track-covariance TCOV]\n"
-      "  Trajectories in TUM format (timestamp tx ty tz qx qy qz qw, T_world_cam).\n"
+      "       plumb eval --gt GT.txt --loops STATS.json [--json]\n"
+      "  Trajectories in TUM format (timestamp tx ty tz qx qy qz qw, T_world_cam); --gt may also\n"
+      "  name a synthetic scene, synth:PRESET[:SEED[:FRAMES]], for its exact ground truth.\n"
       "  ATE: greedy unique association |dt| < 0.02 s, rigid alignment (no scale), RMSE in m.\n"
       "  RPE: pairs ~1 s apart (benchmark evaluate_rpe, fixed delta 1 s): m/s and deg/s.\n"
       "  --plot  write a PNG: top view of ground truth vs aligned estimate, x/y/z error over time\n"
@@ -27,11 +31,21 @@ void printEvalUsage() {
       "  --nees  NEES per dof of the published covariances against ground truth (docs/UNCERTAINTY.md):\n"
       "          --covariance: a `plumb run --covariance` (keyframe-to-keyframe relative poses) or\n"
       "          `--track-covariance` file (tracked poses, frame-to-frame motion; gauge: the first\n"
-      "          pose of --est); --track-covariance: the second file. JSON key nees_per_dof.\n");
+      "          pose of --est); --track-covariance: the second file. JSON key nees_per_dof.\n"
+      "  --loops grade the loop audit of `plumb run --stats STATS.json`: each accepted loop's error,\n"
+      "          loop precision and recall over the revisits of the ground truth (docs/LOOP.md)\n");
 }
 
 Status readTrajectory(const char* role, const std::string& path, std::vector<StampedPose>* poses,
                       TrajectoryReadReport* report) {
+  if (isSynthSpec(path)) {  // exact ground truth of a synthetic scene, e.g. --gt synth:loop:3
+    SynthOptions options;
+    std::unique_ptr<SyntheticScene> scene;
+    Status st = parseSynthSpec(path, &options);
+    if (st.ok()) st = SyntheticScene::create(options, &scene);
+    if (st.ok()) *poses = syntheticGroundTruth(*scene, options.frames);
+    return st.withContext(std::string("reading ") + role);
+  }
   return readTumTrajectory(path, poses, {}, report).withContext(std::string("reading ") + role);
 }
 
@@ -72,16 +86,19 @@ void printText(const AteResult& ate, const RpeResult* rpe, const std::string& rp
 }
 
 int runEval(int argc, char** argv) {
-  Args args(argc, argv, {"gt", "est", "plot", "covariance", "track-covariance"}, {"json", "nees"});
+  Args args(argc, argv, {"gt", "est", "plot", "loops", "covariance", "track-covariance"}, {"json", "nees"});
   if (args.help()) {
     printEvalUsage();
     return 0;
   }
-  if (!args.error().empty() || !args.positional().empty() || !args.has("gt") || !args.has("est")) {
+  const bool loops = args.has("loops");
+  if (!args.error().empty() || !args.positional().empty() || !args.has("gt") || args.has("est") == loops ||
+      (loops && args.has("plot"))) {
     std::fprintf(stderr, "plumb eval: %s\n",
                  !args.error().empty()        ? args.error().c_str()
+                 : loops                      ? "--loops grades a --stats file alone (no --est or --plot)"
                  : !args.positional().empty() ? ("unexpected argument " + args.positional()[0]).c_str()
-                                              : "--gt and --est are required");
+                                              : "--gt and --est (or --loops alone) are required");
     printEvalUsage();
     return 2;
   }
@@ -90,10 +107,20 @@ int runEval(int argc, char** argv) {
     return 2;
   }
   const std::string gt_path = args.get("gt"), est_path = args.get("est"), plot_path = args.get("plot");
+  if (loops) {  // reads the ground truth and the statistics, writes nothing
+    std::vector<StampedPose> ground_truth;
+    TrajectoryReadReport report;
+    const Status st = readTrajectory("ground truth", gt_path, &ground_truth, &report);
+    if (!st.ok()) {
+      std::fprintf(stderr, "plumb eval: %s\n", st.message().c_str());
+      return 1;
+    }
+    return evalLoops(ground_truth, args.get("loops"), args.has("json"));
+  }
   // The plot never overwrites an input (the ground truth, the estimate, a link to either), and
   // its folder must take it: checked before anything is read.
   IoPlan io;
-  io.addInput(gt_path);
+  if (!isSynthSpec(gt_path)) io.addInput(gt_path);
   io.addInput(est_path);
   io.addInput(args.get("covariance"));
   io.addInput(args.get("track-covariance"));

@@ -29,6 +29,7 @@ struct StreamedFrame {
   uint32_t reference_id = 0;
   double T_ref_cam[12] = {};    // 3x4, row major
   double T_world_cam[12] = {};  // real-time pose (fallback)
+  uint64_t loop_epoch = 0;      // FinishedFrame::loop_epoch
 };
 
 void toRows(const Eigen::Isometry3d& T, double* out) {
@@ -82,8 +83,9 @@ void RunOutputs::onPose(const FrameOutput& out) {
   sample.covariance = out.track.covariance;
   sample.has_local_covariance = out.has_pose && out.track.covariance_local_valid;
   sample.local_covariance = out.track.covariance_local;
-  // The estimate jumps at a new map segment and at a relocalization: the autopilot must know.
-  sample.reset = out.new_map || out.relocalized;
+  // The estimate jumps at a new map segment, a relocalization and a loop correction: the
+  // autopilot must know (docs/LOOP.md "What the robot receives").
+  sample.reset = out.new_map || out.relocalized || out.loop_corrected;
   mavlink_->publish(sample);
 }
 
@@ -190,6 +192,7 @@ Status RunOutputs::onFinishedFrame(const FinishedFrame& f) {
     r.reference_id = f.reference_id;
     toRows(f.T_ref_cam, r.T_ref_cam);
     toRows(f.T_world_cam, r.T_world_cam);
+    r.loop_epoch = f.loop_epoch;
     if (std::fwrite(&r, sizeof(r), 1, frames_stream_) != 1) return Status::Error("--out-optimized: temporary file write failed");
   }
   if (!options_.trajectory_path.empty()) return trajectory_writer_.append(pose);
@@ -211,14 +214,13 @@ Status RunOutputs::writeOptimized(const LoopRunResult& loop) {
     pose.valid = r.valid != 0;
     pose.dropped = r.dropped != 0;
     pose.T_world_cam = fromRows(r.T_world_cam);
-    Eigen::Isometry3d T_world_ref;
-    if (pose.valid) {
-      if (r.reference_id != 0 && loop.keyframePose(r.reference_id, &T_world_ref)) {
-        pose.T_world_cam = T_world_ref * fromRows(r.T_ref_cam);
-      } else {
-        ++optimized_without_keyframe_;
-      }
-    }
+    FinishedFrame frame;
+    frame.valid = pose.valid;
+    frame.reference_id = r.reference_id;
+    frame.T_ref_cam = fromRows(r.T_ref_cam);
+    frame.T_world_cam = pose.T_world_cam;
+    frame.loop_epoch = r.loop_epoch;
+    if (pose.valid && !loop.optimisedPose(frame, &pose.T_world_cam)) ++optimized_without_keyframe_;
     if (options_.keep_trajectory) optimized_.push_back(pose);
     PLUMB_RETURN_IF_ERROR(writer.append(pose));
   }

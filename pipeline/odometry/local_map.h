@@ -55,6 +55,12 @@ struct LocalMap {
   bool reference_world_covariance_valid = false;
   int reference_tracked_landmarks = 0;  // landmarks of the reference KF observed by >= 2 keyframes
   int keyframes_in_map = 0;
+  // Loop corrections the mapper has applied to this map segment so far, and their composition
+  // (maps a point of the world before the first of them to the world now). A tracker holding
+  // 3D points from an older snapshot moves ALL of them by the difference (Tracker::setLocalMap):
+  // a correction moves every landmark, not only those this snapshot lists.
+  uint64_t loop_corrections = 0;
+  Eigen::Isometry3d T_loop_corrections = Eigen::Isometry3d::Identity();
   FixedVector<LocalMapKeyframe, kMaxMapKeyframes> keyframes;  // every keyframe in the map, by id
   FixedVector<LocalMapPoint, kMaxLocalMapPoints> points;
   FixedVector<LocalMapLine, kMaxLocalMapLines> lines;
@@ -65,6 +71,8 @@ struct LocalMap {
     reference_world_covariance_valid = false;
     reference_tracked_landmarks = 0;
     keyframes_in_map = 0;
+    loop_corrections = 0;
+    T_loop_corrections = Eigen::Isometry3d::Identity();
     keyframes.clear();
     points.clear();
     lines.clear();

@@ -57,6 +57,8 @@ InsertResult LocalMapper::insertKeyframe(const KeyframeRequest& request) {
   if (request.start_new_map) {
     retireAll();
     map_.clear();
+    loop_corrections_ = 0;
+    T_loop_corrections_ = Eigen::Isometry3d::Identity();
     ++segment_;
     ++stats_.segments;
   } else if (map_.counts().keyframes == 0) {
@@ -124,6 +126,8 @@ bool LocalMapper::applyCorrection(const MapCorrection& correction) {
     l.end_world = C * l.end_world;
   }
   last_correction_ = C;
+  ++loop_corrections_;
+  T_loop_corrections_ = C * T_loop_corrections_;
   publishSnapshot(map_.newestKeyframeSlot());
   correction_version_ = local_map_->version;
   return true;

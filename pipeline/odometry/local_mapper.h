@@ -123,6 +123,9 @@ class LocalMapper {
   // The last correction: snapshots older than this version are in the frame before it.
   uint64_t correction_version_ = 0;
   Eigen::Isometry3d last_correction_ = Eigen::Isometry3d::Identity();
+  // Loop corrections applied in this map segment and their composition (LocalMap's fields).
+  uint64_t loop_corrections_ = 0;
+  Eigen::Isometry3d T_loop_corrections_ = Eigen::Isometry3d::Identity();
   MapperStats stats_;
   FixedVector<RetiredKeyframe, kMaxMapKeyframes> retired_;
 

@@ -10,6 +10,8 @@ void LocalMapper::publishSnapshot(int kf_slot) {
   out.clear();
   out.version = ++snapshot_version_;
   out.segment = segment_;
+  out.loop_corrections = loop_corrections_;
+  out.T_loop_corrections = T_loop_corrections_;
   const Keyframe& reference = map_.keyframe(kf_slot);
   out.reference_keyframe_id = reference.id;
   out.reference_keyframe_sequence = reference.frame_sequence;

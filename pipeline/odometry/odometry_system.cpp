@@ -242,6 +242,12 @@ void OdometrySystem::trackFeatures(const FrameFeatures& features, uint64_t seque
                                    MapperFence* fence, TrackedFrame* out) {
   const auto start = std::chrono::steady_clock::now();
   const bool request_pending = syncWithMapping(fence);
+  const LocalMap& installed = tracking_.tracker->localMap();
+  if (installed.loop_corrections != tracking_.loop_corrections_seen) {
+    // A new segment restarts the count at 0 (and is announced as a new map); only an increase is a jump.
+    tracking_.loop_correction_unannounced |= installed.loop_corrections > tracking_.loop_corrections_seen;
+    tracking_.loop_corrections_seen = installed.loop_corrections;
+  }
   FrameOutput& o = out->output;
   o = FrameOutput{};
   o.sequence = sequence;
@@ -268,6 +274,10 @@ void OdometrySystem::trackFeatures(const FrameFeatures& features, uint64_t seque
   // Once a map exists (or a loaded one is awaited) a frame without a pose is lost.
   if (!o.has_pose && tracking_.phase != TrackingPhase::kStartMap) o.state = TrackingState::kLost;
   if (o.has_pose) tracking_.T_world_last_good = o.T_world_cam;
+  if (o.has_pose && tracking_.loop_correction_unannounced) {
+    o.loop_corrected = true;
+    tracking_.loop_correction_unannounced = false;
+  }
   o.track_ms = millisecondsSince(start);
 }
 
@@ -323,6 +333,9 @@ const FrameOutput& OdometrySystem::mapFrame(const TrackedFrame& tracked) {
     }
   }
   recordOutput(tracked);
+  const LocalMap& world = mapping_.mapper->localMap();
+  mapping_.trajectory.setWorld(mapping_.stats.loop_corrections_applied, world.segment, world.loop_corrections,
+                               world.T_loop_corrections);
   mapping_.stats.output_overflows += !mapping_.trajectory.push(mapping_.output.sequence, mapping_.output.timestamp_s, mapping_.output.has_pose, mapping_.output.T_world_cam, reference_id,
                    T_ref_cam);
   return mapping_.output;

@@ -59,6 +59,9 @@ struct FrameOutput {
   bool keyframe = false;
   bool relocalized = false;
   bool new_map = false;
+  // The pose is the first after a loop correction moved the map (docs/LOOP.md "What the robot
+  // receives"): the trajectory jumps here, MAVLink announces it with reset_counter.
+  bool loop_corrected = false;
   bool dropped = false;  // mapDroppedFrame(): the runtime dropped this frame, nothing else is set
   TrackResult track;
   InsertResult insert;
@@ -190,6 +193,8 @@ class OdometrySystem {
     uint64_t keyframe_requests = 0;  // handed to mapFrame()
     int frames_since_request = 0;    // frames tracked while the newest request was pending
     uint64_t mapper_waits = 0;       // times the bound above made tracking wait
+    uint64_t loop_corrections_seen = 0;  // of the map segment the tracker follows
+    bool loop_correction_unannounced = false;  // installed, no pose published since
   };
   // The mapping thread's state.
   struct MappingSide {

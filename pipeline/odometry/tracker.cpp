@@ -51,6 +51,9 @@ Tracker::~Tracker() = default;
 void Tracker::setLocalMap(const LocalMap& local_map) {
   // Corrections only make sense within one map segment (a new segment restarts with resetAt).
   const bool same_map = local_map_->version != 0 && local_map.segment == local_map_->segment;
+  if (has_last_frame_ && same_map && local_map.loop_corrections != local_map_->loop_corrections) {
+    followLoopCorrection(local_map.T_loop_corrections * local_map_->T_loop_corrections.inverse());
+  }
   *local_map_ = local_map;
   b_->point_visible.fill(0);
   b_->point_found.fill(0);

@@ -104,6 +104,9 @@ class Tracker {
   void rememberLastFrame(const FrameFeatures& frame, const Eigen::Isometry3d& T_world_cam);
   // tracker_last_frame.cpp: the setLocalMap update of the last frame described above.
   void followMapCorrections();
+  // A loop correction moved the whole map by `correction`: every 3D point the last frame holds
+  // (landmarks outside the new snapshot too) moves with it.
+  void followLoopCorrection(const Eigen::Isometry3d& correction);
   void fillKeyframeRequest(const FrameFeatures& frame, uint64_t sequence, double timestamp_s,
                            const Eigen::Isometry3d& T_world_cam, KeyframeRequest* request);
   bool keyframeNeeded(const FrameFeatures& frame, const TrackResult& result) const;

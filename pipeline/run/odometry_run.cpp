@@ -26,6 +26,33 @@ Status validate(const OdometryRunOptions& options) {
   return Status::Ok();
 }
 
+bool LoopRunResult::keyframeFinalPose(uint32_t id, uint64_t epoch, Eigen::Isometry3d* T_world_graph,
+                                      Eigen::Isometry3d* T_world_final) const {
+  const auto it = std::lower_bound(keyframes.begin(), keyframes.end(), id,
+                                   [](const std::pair<uint32_t, Eigen::Isometry3d>& k, uint32_t v) { return k.first < v; });
+  if (it == keyframes.end() || it->first != id) return false;
+  const FinalPose& f = keyframe_finals[std::size_t(it - keyframes.begin())];
+  if (!f.has_final || f.epoch != epoch) return false;
+  *T_world_graph = it->second;
+  *T_world_final = f.T_world_cam;
+  return true;
+}
+
+bool LoopRunResult::optimisedPose(const FinishedFrame& frame, Eigen::Isometry3d* T_world_cam) const {
+  if (!frame.valid || frame.reference_id == 0) return false;
+  Eigen::Isometry3d T_world_ref, T_world_ref_final;
+  if (keyframeFinalPose(frame.reference_id, frame.loop_epoch, &T_world_ref, &T_world_ref_final)) {
+    // Both in the frame's world: without loops the graph is the local map's final chain, so this
+    // is the real-time pose up to one rigid motion, and BA's late changes to a keyframe do not
+    // move frames tracked (and output) long before them.
+    *T_world_cam = T_world_ref * T_world_ref_final.inverse() * frame.T_world_cam;
+    return true;
+  }
+  if (!keyframePose(frame.reference_id, &T_world_ref)) return false;
+  *T_world_cam = T_world_ref * frame.T_ref_cam;
+  return true;
+}
+
 bool LoopRunResult::keyframePose(uint32_t id, Eigen::Isometry3d* T_world_cam) const {
   const auto it = std::lower_bound(keyframes.begin(), keyframes.end(), id,
                                    [](const std::pair<uint32_t, Eigen::Isometry3d>& k, uint32_t v) { return k.first < v; });

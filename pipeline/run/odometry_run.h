@@ -137,8 +137,29 @@ struct LoopRunResult {
   // Every keyframe of the final graph (id ascending) with its optimised pose: the optimised
   // trajectory re-expresses each frame through its reference keyframe's pose here.
   std::vector<std::pair<uint32_t, Eigen::Isometry3d>> keyframes;
+  // The loop audit (pipeline/loop/loop_audit.h), copied at the end of the run.
+  std::vector<loop::LoopAuditEntry> audit;
+  std::vector<loop::LoopAuditKeyframe> audit_keyframes;
+  uint64_t audit_entries_dropped = 0;
+  uint64_t audit_keyframes_dropped = 0;
   // The pose of `id` in the final graph; false when it is not there (culled, or never received).
   bool keyframePose(uint32_t id, Eigen::Isometry3d* T_world_cam) const;
+  // Parallel to keyframes: each one's final local-map pose and the loop epoch of that pose
+  // (LoopCloser::finalPose; has_final false when it never left the local map).
+  struct FinalPose {
+    bool has_final = false;
+    uint64_t epoch = 0;
+    Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
+  };
+  std::vector<FinalPose> keyframe_finals;
+  // The graph pose of `id` and its final local-map pose when that was reported in `epoch`.
+  bool keyframeFinalPose(uint32_t id, uint64_t epoch, Eigen::Isometry3d* T_world_graph,
+                         Eigen::Isometry3d* T_world_final) const;
+  // A finished frame's pose in the optimised trajectory (docs/LOOP.md "Two trajectories"): its
+  // real-time pose moved as the graph moved its reference keyframe from the final local-map pose
+  // (same loop epoch), else its reference keyframe's graph pose times T_ref_cam; false (pose
+  // unchanged) when the frame has no pose or its reference keyframe is not in the graph.
+  bool optimisedPose(const FinishedFrame& frame, Eigen::Isometry3d* T_world_cam) const;
 };
 
 struct OdometryRunResult {

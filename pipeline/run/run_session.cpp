@@ -208,12 +208,22 @@ Status RunSession::finish() {
     r.corrections_published = loop_->correctionsPublished();
     r.capacity = loop_->closer().capacity();
     r.memory_bytes = loop_->closer().memoryBytes();
+    const loop::LoopAudit& audit = loop_->closer().audit();
+    r.audit = audit.entries();
+    r.audit_keyframes = audit.keyframes();
+    r.audit_entries_dropped = audit.entriesDropped();
+    r.audit_keyframes_dropped = audit.keyframesDropped();
     r.keyframes.clear();
+    r.keyframe_finals.clear();
     r.keyframes.reserve(loop_->closer().size());
     for (std::size_t i = 0; i < loop_->closer().size(); ++i) {
       Eigen::Isometry3d T;
       const uint32_t id = loop_->closer().idAt(i);
-      if (loop_->closer().pose(id, &T)) r.keyframes.emplace_back(id, T);
+      if (!loop_->closer().pose(id, &T)) continue;
+      r.keyframes.emplace_back(id, T);
+      LoopRunResult::FinalPose f;
+      f.has_final = loop_->closer().finalPose(id, &f.T_world_cam, &f.epoch);
+      r.keyframe_finals.push_back(f);
     }
     if (options_.save_map != nullptr) {
       loop_->closer().exportMap(options_.save_map);

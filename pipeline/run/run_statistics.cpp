@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "pipeline/odometry/map_capacities.h"
+#include "pipeline/run/loop_audit_json.h"
 #include "platform/process_memory.h"
 #include "runtime/json_text.h"
 
@@ -134,6 +135,7 @@ std::string runSummaryJson(const RunSummary& r) {
     add(std::snprintf(buf, sizeof(buf),
                       "    \"edges_refined\": %" PRIu64 ", \"optimisations\": %" PRIu64 ", \"optimisation_ms_total\": %.3f, \"optimisation_ms_max\": %.3f},\n",
                       ls.edges_refined, ls.optimisations, ls.optimisation_ms_total, ls.optimisation_ms_max));
+    out += loopAuditJson(lr) + ",\n";
   }
   if (r.map_loaded || !r.map_saved_path.empty()) {
     add(std::snprintf(buf, sizeof(buf),

@@ -25,7 +25,7 @@ struct OdometryRun {
   // The optimised trajectory (docs/LOOP.md): each frame through its reference keyframe's pose in
   // the final loop-closing graph; the real-time pose where the keyframe is not in the graph.
   std::vector<StampedPose> optimized;
-  std::vector<std::pair<uint32_t, Eigen::Isometry3d>> references;  // per frame: (id, T_ref_cam)
+  std::vector<FinishedFrame> finished;  // per frame, as the sink received it
   std::vector<FrameOutput> outputs;     // per frame as mapped (when asked for)
   OdometryStats stats;
   MapperStats mapper;
@@ -55,7 +55,7 @@ class CollectingSink final : public OdometrySink {
   }
   Status onFinishedFrame(const FinishedFrame& f) override {
     run_->trajectory.push_back(toStampedPose(f));
-    run_->references.emplace_back(f.reference_id, f.T_ref_cam);
+    run_->finished.push_back(f);
     return Status::Ok();
   }
   // Called first in onFrame(), on the map stage's thread (e.g. to make the map stage slow).
@@ -97,10 +97,7 @@ inline OdometryRun runOdometry(FrameSource& source, const SystemOptions& options
   run.status = runOdometry(capture, options, sink, run_options, &run.result);
   run.optimized = run.trajectory;
   for (std::size_t i = 0; i < run.optimized.size(); ++i) {
-    Eigen::Isometry3d T_world_ref;
-    if (run.optimized[i].valid && run.result.loop.keyframePose(run.references[i].first, &T_world_ref)) {
-      run.optimized[i].T_world_cam = T_world_ref * run.references[i].second;
-    }
+    (void)run.result.loop.optimisedPose(run.finished[i], &run.optimized[i].T_world_cam);
   }
   run.stats = run.result.odometry;
   run.mapper = run.result.mapper;
