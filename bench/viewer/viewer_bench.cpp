@@ -115,8 +115,6 @@ void check(const Status& s) {
 RunNumbers runOnce(const std::string& dataset, runtime::RunMode mode, int clients, int rt_priority) {
   std::unique_ptr<FrameSource> source;
   check(openFrameSource(dataset, "", &source));
-  std::unique_ptr<OdometrySystem> system;
-  check(OdometrySystem::create(source->camera(), SystemOptions{}, &system));
   OdometryRunOptions options;
   options.schedule.mode = mode;
   options.schedule.realtime_priority = rt_priority;
@@ -136,7 +134,7 @@ RunNumbers runOnce(const std::string& dataset, runtime::RunMode mode, int client
   }
   OdometryRunResult result;
   SourceCapture capture(*source);
-  check(runOdometry(capture, *system, viewer ? viewer->wrap(outputs) : outputs, options, &result));
+  check(runOdometry(capture, SystemOptions{}, viewer ? viewer->wrap(outputs) : outputs, options, &result));
   RunNumbers n;
   if (viewer) {
     viewer->stop(1.0);

@@ -62,15 +62,12 @@ inline NeesRun runSyntheticNees(const SynthOptions& synth, SystemOptions system_
   run.status = SyntheticSource::create(synth, &source);
   if (!run.status.ok()) return run;
   system_options.output_delay_frames = 0;
-  std::unique_ptr<OdometrySystem> system;
-  run.status = OdometrySystem::create(source->camera(), system_options, &system);
-  if (!run.status.ok()) return run;
   CovarianceCollectingSink sink;
   SourceCapture capture(*source);
   OdometryRunOptions run_options;
   run_options.loop_closing = false;
   OdometryRunResult result;
-  run.status = runOdometry(capture, *system, sink, run_options, &result);
+  run.status = runOdometry(capture, system_options, sink, run_options, &result);
   if (!run.status.ok()) return run;
   const std::vector<StampedPose> gt = syntheticGroundTruth(source->scene(), synth.frames);
   StampedPose anchor;

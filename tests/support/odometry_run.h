@@ -84,7 +84,7 @@ inline OdometryRun runOdometry(FrameSource& source, const SystemOptions& options
   // Sized up front when the source knows its length, so the sink does not allocate per frame and
   // the run's own allocation count (OdometryRunResult::allocations_after_warmup) is the pipeline's.
   run.trajectory.reserve(source.frameCount());
-  run.references.reserve(source.frameCount());
+  run.finished.reserve(source.frameCount());
   CollectingSink sink(settings.keep_outputs, &run);
   sink.on_frame = settings.on_frame;
   sink.on_pose = settings.on_pose;
