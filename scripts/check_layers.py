@@ -98,6 +98,10 @@ def header_family(name):
         return "std"
     if name.endswith(".h") and name[:-2] in STD_C:
         return "std"
+    # The compiler's own SIMD intrinsics (x86 SSE/AVX, ARM NEON): part of the toolchain, like std.
+    if name in ("emmintrin.h", "xmmintrin.h", "pmmintrin.h", "tmmintrin.h", "smmintrin.h", "nmmintrin.h",
+                "immintrin.h", "arm_neon.h"):
+        return "std"
     if (name.endswith(".h") and name[:-2] in POSIX_H) or name.startswith(POSIX_DIRS):
         return "posix"
     if name.startswith(("Eigen/", "unsupported/Eigen/")):
