@@ -30,6 +30,7 @@ TEST_PACKAGES=(
   valgrind  # ctest instruction_budget (bench/instructions/; skipped without it)
   libceres-dev  # plumb_bench_solver's and plumb_test_solver_ceres's oracle (never linked by the product)
   clang libclang-rt-14-dev  # fuzz targets (scripts/fuzz.sh): libFuzzer is in libclang-rt-14-dev
+  clang-tidy  # scripts/tidy.sh: bugprone and naming checks of .clang-tidy
   nodejs npm  # tests/mavlink_node, tests/viewer_node (pinned npm packages); builds the viewer page
   chromium    # the viewer page test (ctest viewer_page, headless, driven by playwright-core)
   # the virtual-machine camera bench (scripts/vm_camera_test.sh, ctest vm_camera).

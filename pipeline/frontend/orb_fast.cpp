@@ -51,8 +51,9 @@ void FastDetector::begin(const cv::Mat& image, int border) {
   dropped_ = 0;
   num_raw_ = 0;
   const int x_end = image.cols - border_, y_end = image.rows - border_;
+  const int row_bytes = x_end - border_ + 2;
   for (int y = border_ - 1; y <= y_end; ++y) {
-    std::memset(score_.ptr<uint8_t>(y) + border_ - 1, 0, static_cast<size_t>(x_end - border_ + 2));
+    std::memset(score_.ptr<uint8_t>(y) + border_ - 1, 0, static_cast<size_t>(row_bytes));
   }
 }
 
