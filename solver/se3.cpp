@@ -53,11 +53,11 @@ Eigen::Vector3d logSO3(const Eigen::Matrix3d& R) {
   // Near pi sin(theta) -> 0 and the skew part carries no axis information. The symmetric part is
   // cos(theta) I + (1 - cos(theta)) a a^T: read the axis from its largest diagonal entry, and
   // its sign from the (still non-zero) skew part.
-  const Eigen::Matrix3d aaT =
+  const Eigen::Matrix3d a_aT =
       (0.5 * (R + R.transpose()) - cos_theta * Eigen::Matrix3d::Identity()) / (1.0 - cos_theta);
   int k = 0;
-  aaT.diagonal().maxCoeff(&k);
-  Eigen::Vector3d axis = aaT.col(k) / std::sqrt(std::max(aaT(k, k), 1e-300));
+  a_aT.diagonal().maxCoeff(&k);
+  Eigen::Vector3d axis = a_aT.col(k) / std::sqrt(std::max(a_aT(k, k), 1e-300));
   axis.normalize();
   if (axis.dot(w) < 0.0) axis = -axis;
   return theta * axis;

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 
+#include "pipeline/frontend/descriptor_match.h"
 #include "solver/pose_optimizer.h"
 
 namespace plumb::loop {
@@ -48,28 +49,6 @@ LoopVerifier::LoopVerifier(const CameraIntrinsics& camera, const NoiseModelOptio
 
 LoopVerifier::~LoopVerifier() = default;
 
-namespace {
-
-// Index of the best descriptor in [0, n) for d if it passes the threshold and ratio test, else -1.
-int bestMatch(const Descriptor256& d, const Descriptor256* others, std::size_t n, int threshold,
-              float ratio) {
-  int best = 256, second = 256, best_index = -1;
-  for (std::size_t j = 0; j < n; ++j) {
-    const int dist = hammingDistance(d, others[j]);
-    if (dist < best) {
-      second = best;
-      best = dist;
-      best_index = int(j);
-    } else if (dist < second) {
-      second = dist;
-    }
-  }
-  if (best_index < 0 || best > threshold || float(best) >= ratio * float(second)) return -1;
-  return best_index;
-}
-
-}  // namespace
-
 bool LoopVerifier::lineAgrees(const LoopLine& query_line, const Eigen::Vector3f* candidate_samples,
                               std::size_t count, const Eigen::Isometry3d& T_query_candidate) const {
   if (count < 2 || query_line.num_samples < 2) return false;
@@ -109,7 +88,7 @@ LoopMeasurement LoopVerifier::verify(const LoopKeyframe& query, const LoopCandid
   // 1. Points.
   int n = 0;
   for (std::size_t k = 0; k < query.points.size(); ++k) {
-    const int j = bestMatch(query.point_descriptors[k], candidate.point_descriptors.data(),
+    const int j = bestRatioMatch(query.point_descriptors[k], candidate.point_descriptors.data(),
                             candidate.num_points, options_.hamming_threshold, options_.ratio);
     if (j < 0) continue;
     s.query_index[std::size_t(n)] = uint16_t(k);
@@ -154,7 +133,7 @@ LoopMeasurement LoopVerifier::verify(const LoopKeyframe& query, const LoopCandid
     const Eigen::Isometry3d T_qc = T_cq.inverse();
     for (std::size_t k = 0; k < query.lines.size(); ++k) {
       const int j =
-          bestMatch(query.line_descriptors[k], candidate.line_descriptors.data(), candidate.num_lines,
+          bestRatioMatch(query.line_descriptors[k], candidate.line_descriptors.data(), candidate.num_lines,
                     options_.line_hamming_threshold, options_.line_ratio);
       if (j < 0) continue;
       const std::size_t first = candidate.first_sample[std::size_t(j)];

@@ -2,7 +2,7 @@
 // LoopVerifier: decides whether two LoopKeyframe records see the same place, and if so measures
 // their relative pose (docs/LOOP.md "Verification"):
 //   1. ORB matching query -> candidate: brute-force Hamming, absolute threshold + Lowe ratio;
-//   2. rigid 3D-3D RANSAC on the matched points (both have depth): rigid_ransac.h;
+//   2. rigid 3D-3D RANSAC on the matched points (both have depth): solver/rigid_fit.h;
 //   3. refinement of T_query_candidate with the pose-only optimiser (solver/pose_optimizer.h):
 //      the candidate's 3D points against the query's [u, v, u_r] observations (RANSAC inliers),
 //      plus the candidate's line-guidance samples against the query's 2D lines for LBD matches;
@@ -17,9 +17,9 @@
 #include <memory>
 
 #include "pipeline/loop/loop_keyframe.h"
-#include "pipeline/loop/rigid_ransac.h"
 #include "solver/camera_intrinsics.h"
 #include "solver/noise_model.h"
+#include "solver/rigid_fit.h"
 #include "solver/types.h"
 
 namespace plumb::loop {
