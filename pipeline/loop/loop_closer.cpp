@@ -133,7 +133,7 @@ Matrix6d LoopCloser::edgeCovariance(bool new_segment, const Matrix6d& covariance
     return diagonalCovariance(options_.segment_translation_sigma_m, options_.segment_rotation_sigma_rad);
   if (covariance_valid && finiteSpd(covariance)) {
     return 0.5 * (covariance + covariance.transpose()) +
-           diagonalCovariance(options_.floor_translation_sigma_m, options_.floor_rotation_sigma_rad);
+           diagonalCovariance(options_.odometry_floor_translation_sigma_m, options_.odometry_floor_rotation_sigma_rad);
   }
   return diagonalCovariance(options_.default_translation_sigma_m, options_.default_rotation_sigma_rad);
 }

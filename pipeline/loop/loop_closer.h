@@ -4,8 +4,8 @@
 //
 // addKeyframe(record), for each keyframe the mapping side inserted, in id order:
 //   1. graph: a node for the keyframe, linked to the previous node by an odometry edge
-//      T_previous_this weighted by its calibrated covariance from local BA's joint marginal (+ a
-//      floor; docs/UNCERTAINTY.md), or by a default
+//      T_previous_this weighted by its calibrated covariance from local BA's joint marginal
+//      (docs/UNCERTAINTY.md; + a numerical floor only), or by a default
 //      information when BA gave none; a new map segment is linked by a weak edge.
 //   2. detection: KeyframeDatabase query, candidates older than min_age_keyframes (outside the
 //      local window); a candidate must be consistent over min_consistent consecutive queries
@@ -63,10 +63,20 @@ struct LoopCloserOptions {
   int cooldown_keyframes = 3;         // after an accepted loop, keyframes not searched
   LoopVerifierOptions verifier;
   int bits_per_word = kDefaultWordBits;
-  // Odometry edge covariance when local BA gave none; the floor is added to BA's covariances,
-  // which know the measurement noise only (not the model errors that make odometry drift).
+  // Odometry edge covariance when local BA gave none.
   double default_translation_sigma_m = 0.02;
   double default_rotation_sigma_rad = 0.01;
+  // Added to BA's covariance of an odometry edge: numerical only (every edge's information stays
+  // finite), 30x and 20x below the 3 mm / 0.002 rad model floor these edges had before. BA's
+  // relative covariances are calibrated (variance factor, correlation factor, rolling-shutter
+  // model error: docs/UNCERTAINTY.md), so they already carry the model errors that make odometry
+  // drift; a model floor on top dominated them 3-10x, weighted every edge alike whatever BA knew,
+  // and a loop's correction then went into the edges that had no error (docs/LOOP.md "Why a
+  // correct loop made the optimised trajectory worse").
+  double odometry_floor_translation_sigma_m = 1e-4;
+  double odometry_floor_rotation_sigma_rad = 1e-4;
+  // Added to the loop edge's covariance (the verifier's, not calibrated: it holds the candidate's
+  // points exact) and to the plausibility test's sum.
   double floor_translation_sigma_m = 0.003;
   double floor_rotation_sigma_rad = 0.002;
   // The first keyframe of a new map segment: the tracker restarted at its last known pose.

@@ -85,6 +85,8 @@ class LocalMapper {
 
   // Keyframes retired since the last clearRetired(), in retirement order.
   const FixedVector<RetiredKeyframe, kMaxMapKeyframes>& retired() const { return retired_; }
+  // The rigid motion the last applied loop correction moved the map by (applyCorrection's C).
+  const Eigen::Isometry3d& lastCorrection() const { return last_correction_; }
   void clearRetired() { retired_.clear(); }
   // Retires every keyframe still in the map (end of a run), oldest first.
   void retireAll();

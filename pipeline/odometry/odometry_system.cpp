@@ -309,6 +309,8 @@ bool OdometrySystem::applyLoopCorrection() {
   }
   ++mapping_.stats.loop_corrections_applied;
   mapping_.last_correction = *correction;
+  if (mapping_.applied_corrections.size() < kMaxRecordedCorrections)
+    mapping_.applied_corrections.push_back(mapping_.mapper->lastCorrection());
   const LocalMap& snapshot = mapping_.mapper->localMap();
   snapshots_->writeBuffer() = snapshot;
   snapshots_->publish(snapshot.version);

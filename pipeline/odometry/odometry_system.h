@@ -33,6 +33,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "sensor/camera.h"
 #include "pipeline/frontend/frame_features.h"
@@ -160,6 +161,11 @@ class OdometrySystem {
   // Mapping side: the newest correction applyLoopCorrection() applied (a copy; keyframe_id 0
   // before the first). Viewers draw loop edges from it.
   const MapCorrection& lastLoopCorrection() const { return mapping_.last_correction; }
+  // The rigid motion each applied correction moved the map by, in order: entry e - 1 takes loop
+  // epoch e - 1 to epoch e (FinishedFrame::loop_epoch). The first kMaxRecordedCorrections are kept
+  // (reserved at construction); later ones are counted in stats only.
+  static constexpr std::size_t kMaxRecordedCorrections = 512;
+  const std::vector<Eigen::Isometry3d>& appliedCorrections() const { return mapping_.applied_corrections; }
   // The mapper, read by the mapping side's own thread (loop records).
   const LocalMapper& mapper() const { return *mapping_.mapper; }
   const OdometryStats& stats() const { return mapping_.stats; }
@@ -204,7 +210,10 @@ class OdometrySystem {
     FrameOutput output;
     uint64_t correction_version = 0;  // newest loop correction seen (0: none)
     MapCorrection last_correction;    // newest one applied
-    explicit MappingSide(int delay_frames) : trajectory(delay_frames) {}
+    std::vector<Eigen::Isometry3d> applied_corrections;  // appliedCorrections()
+    explicit MappingSide(int delay_frames) : trajectory(delay_frames) {
+      applied_corrections.reserve(kMaxRecordedCorrections);
+    }
   };
 
   // Tracking side. syncWithMapping: the schedule's part (waits, the newest snapshot); returns

@@ -32,9 +32,14 @@ bool LoopRunResult::keyframeFinalPose(uint32_t id, uint64_t epoch, Eigen::Isomet
                                    [](const std::pair<uint32_t, Eigen::Isometry3d>& k, uint32_t v) { return k.first < v; });
   if (it == keyframes.end() || it->first != id) return false;
   const FinalPose& f = keyframe_finals[std::size_t(it - keyframes.begin())];
-  if (!f.has_final || f.epoch != epoch) return false;
+  if (!f.has_final || f.epoch < epoch || f.epoch > epoch_corrections.size()) return false;
+  // Corrections applied after the frame was queued and before the keyframe retired moved the
+  // local map, that keyframe with it, by C (a new map segment retires every keyframe first, so
+  // they are all of the keyframe's segment): back to the frame's world.
+  Eigen::Isometry3d T_later_earlier = Eigen::Isometry3d::Identity();
+  for (uint64_t e = epoch; e < f.epoch; ++e) T_later_earlier = epoch_corrections[std::size_t(e)] * T_later_earlier;
   *T_world_graph = it->second;
-  *T_world_final = f.T_world_cam;
+  *T_world_final = T_later_earlier.inverse() * f.T_world_cam;
   return true;
 }
 
@@ -44,7 +49,9 @@ bool LoopRunResult::optimisedPose(const FinishedFrame& frame, Eigen::Isometry3d*
   if (keyframeFinalPose(frame.reference_id, frame.loop_epoch, &T_world_ref, &T_world_ref_final)) {
     // Both in the frame's world: without loops the graph is the local map's final chain, so this
     // is the real-time pose up to one rigid motion, and BA's late changes to a keyframe do not
-    // move frames tracked (and output) long before them.
+    // move frames tracked (and output) long before them. With loops, every frame keeps its
+    // real-time pose relative to its reference keyframe's final pose, also when a correction
+    // came between the two (docs/LOOP.md "Why a correct loop made the optimised trajectory worse").
     *T_world_cam = T_world_ref * T_world_ref_final.inverse() * frame.T_world_cam;
     return true;
   }

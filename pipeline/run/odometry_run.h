@@ -152,12 +152,18 @@ struct LoopRunResult {
     Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
   };
   std::vector<FinalPose> keyframe_finals;
-  // The graph pose of `id` and its final local-map pose when that was reported in `epoch`.
+  // The rigid motion of each loop correction the mapping side applied (OdometrySystem::
+  // appliedCorrections): entry e - 1 takes the world of loop epoch e - 1 to that of epoch e.
+  std::vector<Eigen::Isometry3d> epoch_corrections;
+  // The graph pose of `id` and its final local-map pose expressed in the world of loop epoch
+  // `epoch` (the corrections applied between `epoch` and the epoch the final pose was reported in
+  // undone: they moved the whole local map rigidly, that keyframe included); false when it has no
+  // final pose, or one reported before `epoch`, or those corrections were not recorded.
   bool keyframeFinalPose(uint32_t id, uint64_t epoch, Eigen::Isometry3d* T_world_graph,
                          Eigen::Isometry3d* T_world_final) const;
   // A finished frame's pose in the optimised trajectory (docs/LOOP.md "Two trajectories"): its
   // real-time pose moved as the graph moved its reference keyframe from the final local-map pose
-  // (same loop epoch), else its reference keyframe's graph pose times T_ref_cam; false (pose
+  // (in the frame's loop epoch), else its reference keyframe's graph pose times T_ref_cam; false (pose
   // unchanged) when the frame has no pose or its reference keyframe is not in the graph.
   bool optimisedPose(const FinishedFrame& frame, Eigen::Isometry3d* T_world_cam) const;
 };

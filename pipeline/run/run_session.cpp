@@ -215,6 +215,7 @@ Status RunSession::finish() {
     r.audit_keyframes_dropped = audit.keyframesDropped();
     r.keyframes.clear();
     r.keyframe_finals.clear();
+    r.epoch_corrections = system_->appliedCorrections();
     r.keyframes.reserve(loop_->closer().size());
     for (std::size_t i = 0; i < loop_->closer().size(); ++i) {
       Eigen::Isometry3d T;
