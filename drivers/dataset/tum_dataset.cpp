@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -59,9 +60,10 @@ int64_t monotonicNowNs() {
 
 // Reads the whole file into `bytes` (grown only when a file is larger than any before: no
 // allocation per frame; POSIX read, because stdio's FILE allocates its buffer on every fopen).
-Status readFileBytes(const std::string& path, std::unique_ptr<unsigned char[]>* bytes, std::size_t* capacity,
-                     std::size_t* size) {
-  InputFile file;
+// `file` is the caller's, reused frame after frame: its path string keeps its capacity, so opening
+// the next image allocates nothing (a fresh opener per image cost two allocations a frame).
+Status readFileBytes(const std::string& path, InputFile& file, std::unique_ptr<unsigned char[]>* bytes,
+                     std::size_t* capacity, std::size_t* size) {
   PLUMB_RETURN_IF_ERROR(file.open(path, kMaxImageFileBytes, "image file"));
   const int fd = file.fd();
   const auto expected = static_cast<std::size_t>(file.size());
@@ -133,13 +135,19 @@ Status TumDatasetSource::open(const std::string& dir, const PinholeCamera& camer
     source->depth_files_.push_back(dir + "/" + frame.depth_path);
   }
   source->png_ = std::make_unique<PngDecoder>();
+  // Buffers for the largest image file the camera's images can be (colour, or depth at the depth
+  // camera's size), once: replaying then allocates nothing per frame, whatever the file sizes.
+  const int width = std::max(camera.width, camera.depthWidth()), height = std::max(camera.height, camera.depthHeight());
+  source->png_->reserve(width, height);
+  source->file_capacity_ = pngFileBound(width, height, 3);
+  source->file_bytes_.reset(new unsigned char[source->file_capacity_]);  // not zero-filled: address space only
   *out = std::move(source);
   return Status::Ok();
 }
 
 Status TumDatasetSource::loadImage(const std::string& path, bool is_depth, cv::Mat& dst) {
   std::size_t size = 0;
-  PLUMB_RETURN_IF_ERROR(readFileBytes(path, &file_bytes_, &file_capacity_, &size));
+  PLUMB_RETURN_IF_ERROR(readFileBytes(path, image_file_, &file_bytes_, &file_capacity_, &size));
   PngHeader header;
   if (png_->readHeader(file_bytes_.get(), size, &header)) {
     // PNG (every TUM and ICL-NUIM image): libpng straight into dst, checked before decoding.

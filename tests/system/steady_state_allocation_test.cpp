@@ -55,4 +55,29 @@ TEST(SteadyStateAllocations, ThreadedSyntheticRunAllocatesNothingPerFrameAfterFr
   EXPECT_EQ(allocations, 0u) << output;
 }
 
+// The same for a replay of a TUM folder (the images read from files, per frame): the reader reuses
+// its file buffer and its opener's path, so decoding allocates nothing either. The folder is a
+// synthetic scene written by `plumb synth`, under a path longer than any short-string buffer.
+TEST(SteadyStateAllocations, ThreadedTumFolderReplayAllocatesNothingPerFrameAfterFrame30) {
+  std::string dir_pattern = (fs::temp_directory_path() / "plumb_alloc_tum_replay_XXXXXX").string();
+  ASSERT_NE(::mkdtemp(dir_pattern.data()), nullptr);
+  const std::string folder = dir_pattern + "/scene", trajectory = dir_pattern + "/trajectory.txt";
+  std::string output;
+  ASSERT_EQ(runPlumb("synth --preset low_texture --seed 1 --frames 120 --out '" + folder + "'", &output), 0) << output;
+  output.clear();
+  const int exit_code =
+      runPlumb("run --dataset '" + folder + "' --out '" + trajectory + "' --mode fast --count-allocations", &output);
+  std::error_code ignored;
+  fs::remove_all(dir_pattern, ignored);
+  ASSERT_EQ(exit_code, 0) << output;
+  const std::string key = "allocations after warm-up: ";
+  const std::size_t at = output.find(key);
+  ASSERT_NE(at, std::string::npos) << output;
+  unsigned long long allocations = 0, frames = 0;
+  ASSERT_EQ(std::sscanf(output.c_str() + at + key.size(), "%llu over %llu frames", &allocations, &frames), 2)
+      << output;
+  EXPECT_GE(frames, 80u) << output;
+  EXPECT_EQ(allocations, 0u) << output;
+}
+
 }  // namespace
