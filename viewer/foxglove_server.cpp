@@ -2,7 +2,7 @@
 
 // websocketpp on standalone asio (no Boost), C++11 standard library primitives.
 #define ASIO_STANDALONE
-#define _WEBSOCKETPP_CPP11_STL_
+#define _WEBSOCKETPP_CPP11_STL_  // NOLINT(bugprone-reserved-identifier): websocketpp's own switch
 #include <websocketpp/config/asio_no_tls.hpp>
 #include <websocketpp/server.hpp>
 
