@@ -31,6 +31,19 @@ int runPlumb(const std::string& arguments, std::string* output) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+// Reads "allocations after warm-up: <count> over <frames> frames (<per frame> per frame)" from the
+// tool's output and checks that at least min_frames were counted and none of them allocated.
+void expectNoAllocationsAfterWarmup(const std::string& output, unsigned long long min_frames) {
+  const std::string key = "allocations after warm-up: ";
+  const std::size_t at = output.find(key);
+  ASSERT_NE(at, std::string::npos) << output;
+  unsigned long long allocations = 0, frames = 0;
+  ASSERT_EQ(std::sscanf(output.c_str() + at + key.size(), "%llu over %llu frames", &allocations, &frames), 2)
+      << output;
+  EXPECT_GE(frames, min_frames) << output;
+  EXPECT_EQ(allocations, 0u) << output;
+}
+
 TEST(SteadyStateAllocations, ThreadedSyntheticRunAllocatesNothingPerFrameAfterFrame30) {
   std::string dir_pattern = (fs::temp_directory_path() / "plumb_alloc_XXXXXX").string();
   ASSERT_NE(::mkdtemp(dir_pattern.data()), nullptr);
@@ -42,17 +55,8 @@ TEST(SteadyStateAllocations, ThreadedSyntheticRunAllocatesNothingPerFrameAfterFr
   std::error_code ignored;
   fs::remove_all(dir_pattern, ignored);
   ASSERT_EQ(exit_code, 0) << output;
-
-  // "allocations after warm-up: <count> over <frames> frames (<per frame> per frame)"
-  const std::string key = "allocations after warm-up: ";
-  const std::size_t at = output.find(key);
-  ASSERT_NE(at, std::string::npos) << output;
-  unsigned long long allocations = 0, frames = 0;
-  ASSERT_EQ(std::sscanf(output.c_str() + at + key.size(), "%llu over %llu frames", &allocations, &frames), 2)
-      << output;
   // Frames 30..199, less the last few still in flight when the input ended (teardown excluded).
-  EXPECT_GE(frames, 150u) << output;
-  EXPECT_EQ(allocations, 0u) << output;
+  expectNoAllocationsAfterWarmup(output, 150);
 }
 
 // The same for a replay of a TUM folder (the images read from files, per frame): the reader reuses
@@ -70,14 +74,7 @@ TEST(SteadyStateAllocations, ThreadedTumFolderReplayAllocatesNothingPerFrameAfte
   std::error_code ignored;
   fs::remove_all(dir_pattern, ignored);
   ASSERT_EQ(exit_code, 0) << output;
-  const std::string key = "allocations after warm-up: ";
-  const std::size_t at = output.find(key);
-  ASSERT_NE(at, std::string::npos) << output;
-  unsigned long long allocations = 0, frames = 0;
-  ASSERT_EQ(std::sscanf(output.c_str() + at + key.size(), "%llu over %llu frames", &allocations, &frames), 2)
-      << output;
-  EXPECT_GE(frames, 80u) << output;
-  EXPECT_EQ(allocations, 0u) << output;
+  expectNoAllocationsAfterWarmup(output, 80);
 }
 
 }  // namespace
