@@ -6,7 +6,7 @@ Usage: scripts/check_layers.py [SOURCE_DIR]        (default: the repository hold
 
 Exit 0 when the tree is clean, 1 with one `path:line: message` per violation, 2 on a usage error.
 Python 3 standard library only. Registered as the ctest test `layering`; its own test is
-tests/tools/layer_check_test.py (ctest `layering_selftest`).
+tests/scripts/layer_check_test.py (ctest `layering_selftest`).
 
 Why a resolver and not a pattern match: the compiler looks for "x.h" next to the including file
 first and then on the include path (the source root only), and for <x> on the include path and
@@ -816,7 +816,13 @@ class CMakeModel:
             found = []
             for p in patterns:
                 full = p if os.path.isabs(p) else os.path.join(self.root, directory, p)
-                found.extend(sorted(glob.glob(full, recursive=words[0] == "GLOB_RECURSE")))
+                if words[0] == "GLOB_RECURSE":
+                    # CMake matches the file name part in the folder and in all its subfolders
+                    # (tests/<area>/*.cpp takes tests/<area>/<sub>/*.cpp too).
+                    folder, name = os.path.split(full)
+                    found.extend(sorted(glob.glob(os.path.join(folder, "**", name), recursive=True)))
+                else:
+                    found.extend(sorted(glob.glob(full)))
             if relative:
                 found = [os.path.relpath(f, relative) for f in found]
             variables[words[1]] = ";".join(found)

@@ -32,8 +32,7 @@ TSAN_OPTIONS="halt_on_error=1" ctest --test-dir build-tsan --output-on-failure -
 elapsed "ThreadSanitizer done"
 
 echo "== AddressSanitizer + UBSan: every area but system (scripts/sanitize.sh) =="
-PRESET=asan-fast bash scripts/sanitize.sh platform runtime solver pipeline odometry loop drivers devices \
-  mavlink api tools mapfile viewer
+PRESET=asan-fast bash scripts/sanitize.sh platform runtime solver pipeline drivers api tools viewer
 elapsed "AddressSanitizer done"
 
 echo "== Fuzzing: every parser, 20 s each (scripts/fuzz.sh) =="

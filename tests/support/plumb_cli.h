@@ -1,6 +1,6 @@
 #pragma once
 // Shared by the command-line tests: run the built `plumb` tool and capture what it prints, and a
-// private scratch folder per test (ctest runs tests as parallel processes).
+// private scratch folder per test (tests/support/scratch_dir.h).
 #include <sys/wait.h>
 
 #include <cstdio>
@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+
+#include "tests/support/scratch_dir.h"
 
 namespace plumb::test {
 
@@ -31,31 +33,5 @@ inline RunResult runPlumb(const std::string& arguments) {
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
 }
-
-// A fresh folder under the temp directory, removed with everything in it at destruction.
-class ScratchDir {
- public:
-  explicit ScratchDir(const std::string& prefix) {
-    std::string pattern = (std::filesystem::temp_directory_path() / (prefix + "_XXXXXX")).string();
-    if (::mkdtemp(pattern.data())) path_ = pattern;
-  }
-  ~ScratchDir() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
-  ScratchDir(const ScratchDir&) = delete;
-  ScratchDir& operator=(const ScratchDir&) = delete;
-
-  bool ok() const { return !path_.empty(); }
-  std::string file(const std::string& name) const { return path_ + "/" + name; }
-  // Writes `content` to a file in the folder and returns its path.
-  std::string write(const std::string& name, const std::string& content) const {
-    std::ofstream(file(name), std::ios::binary) << content;
-    return file(name);
-  }
-
- private:
-  std::string path_;
-};
 
 }  // namespace plumb::test

@@ -1,0 +1,307 @@
+// LoopCloser on chains of hand-made keyframe records: a drifted loop is closed and corrected, a
+// corridor of repeated modules yields no loop, capacity and culling keep everything bounded, and
+// adding keyframes allocates nothing.
+#include "pipeline/loop/loop_closer.h"
+
+#include <gtest/gtest.h>
+
+#include "platform/allocation_counter.h"
+#include "solver/se3.h"
+#include "tests/pipeline/loop/loop_test_scenes.h"
+
+namespace plumb::test {
+namespace {
+
+loop::LoopCloser makeCloser(const loop::LoopCloserOptions& options) {
+  return loop::LoopCloser(intrinsicsOf(syntheticCamera()), NoiseModelOptions{}, options);
+}
+
+// Odometry that drifts: every measured step is the true one times a small yaw and forward error.
+Eigen::Isometry3d driftedStep(const Eigen::Isometry3d& true_step) {
+  Eigen::Isometry3d error = Eigen::Isometry3d::Identity();
+  error.linear() = Eigen::AngleAxisd(0.04 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  error.translation() = Eigen::Vector3d(0.0015, 0, 0.001);
+  return true_step * error;
+}
+
+TEST(LoopCloser, ClosesADriftedLoopAndCorrectsTheGraph) {
+  const Scene scene = cylinderScene(21, 6000, 3.5);
+  constexpr int kPerLap = 100, kTotal = 170;
+  auto pose_at = [&](int k) { return outwardPose(2 * M_PI * k / kPerLap, 1.0); };
+  loop::LoopCloserOptions options;
+  options.capacity = 256;  // every keyframe stays in the graph (no culling in this test)
+  loop::LoopCloser closer = makeCloser(options);
+  Eigen::Isometry3d T_odometry = pose_at(0);
+  int accepted_at = -1;
+  for (int k = 0; k < kTotal; ++k) {
+    Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+    if (k > 0) {
+      step = driftedStep(pose_at(k - 1).inverse() * pose_at(k));
+      T_odometry = T_odometry * step;
+    }
+    const auto record =
+        recordOf(scene, uint32_t(k + 1), pose_at(k), T_odometry, k > 0 ? uint32_t(k) : 0, step);
+    if (closer.addKeyframe(*record) && accepted_at < 0) {
+      accepted_at = k;
+      EXPECT_EQ(closer.correction().keyframe_id, uint32_t(k + 1));
+    }
+  }
+  // The first lap's end already overlaps its start (the field of view spans ~10 keyframes), and
+  // lap 2 revisits lap 1.
+  ASSERT_GE(accepted_at, kPerLap - 15);
+  EXPECT_LT(accepted_at, kPerLap + 10);
+  EXPECT_GE(closer.stats().loops_accepted, 2u);
+  EXPECT_EQ(closer.stats().rejected[int(loop::LoopRejection::kImplausible)], 0u);
+  // Drift of the odometry at the end against the graph after closing.
+  double odometry_error = 0, graph_error = 0, odometry_last = 0, graph_last = 0;
+  Eigen::Isometry3d T_chain = pose_at(0);
+  for (int k = 0; k < kTotal; ++k) {
+    if (k > 0) T_chain = T_chain * driftedStep(pose_at(k - 1).inverse() * pose_at(k));
+    Eigen::Isometry3d T_graph;
+    ASSERT_TRUE(closer.pose(uint32_t(k + 1), &T_graph));
+    odometry_error += translationError(T_chain, pose_at(k));
+    graph_error += translationError(T_graph, pose_at(k));
+    odometry_last = translationError(T_chain, pose_at(k));
+    graph_last = translationError(T_graph, pose_at(k));
+  }
+  odometry_error /= kTotal;
+  graph_error /= kTotal;
+  std::printf(
+      "keyframe position error, mean / last: odometry %.4f / %.4f m, after loop closing %.4f / %.4f m\n",
+      odometry_error, odometry_last, graph_error, graph_last);
+  EXPECT_GT(odometry_error, 0.05);
+  // The bias of every step stays in the odometry edges (the graph spreads, not removes, it): the
+  // mean halves, the end of the chain (pulled onto lap 1) improves most.
+  EXPECT_LT(graph_error, 0.5 * odometry_error);
+  EXPECT_LT(graph_last, 0.4 * odometry_last);
+  EXPECT_GE(closer.stats().optimisations, 1u);
+}
+
+// A corridor of identical 3 m modules along x (points on the wall y = 2 m, the same descriptors
+// in every module), walked one way with exact odometry: every module looks like the one before.
+TEST(LoopCloser, RejectsRepeatedTextureWithoutARealLoop) {
+  Scene module;
+  {
+    std::mt19937_64 rng(31);
+    std::uniform_real_distribution<double> x(0, 3), z(0.4, 2.6), response(10, 100);
+    for (int i = 0; i < 400; ++i) {
+      ScenePoint p;
+      p.P_world = Eigen::Vector3d(x(rng), 2.0, z(rng));
+      p.descriptor = randomDescriptor(rng);
+      p.response = float(response(rng));
+      module.points.push_back(p);
+    }
+  }
+  Scene corridor;
+  for (int m = 0; m < 7; ++m) {
+    for (ScenePoint p : module.points) {
+      p.P_world.x() += 3.0 * m;
+      corridor.points.push_back(p);
+    }
+  }
+  auto pose_at = [](int k) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear().col(0) = Eigen::Vector3d(1, 0, 0);
+    T.linear().col(1) = Eigen::Vector3d(0, 0, -1);
+    T.linear().col(2) = Eigen::Vector3d(0, 1, 0);
+    T.translation() = Eigen::Vector3d(1.5 + 0.075 * k, 0, 1.5);
+    return T;
+  };
+  loop::LoopCloser closer = makeCloser(loop::LoopCloserOptions{});
+  loop::LoopVerifier verifier(intrinsicsOf(syntheticCamera()), NoiseModelOptions{},
+                              loop::LoopVerifierOptions{});
+  const int kTotal = 200;  // 15 m: five modules
+  for (int k = 0; k < kTotal; ++k) {
+    const Eigen::Isometry3d step =
+        k > 0 ? pose_at(k - 1).inverse() * pose_at(k) : Eigen::Isometry3d::Identity();
+    const auto record =
+        recordOf(corridor, uint32_t(k + 1), pose_at(k), pose_at(k), k > 0 ? uint32_t(k) : 0, step);
+    EXPECT_FALSE(closer.addKeyframe(*record)) << "false loop at keyframe " << k;
+  }
+  EXPECT_EQ(closer.stats().loops_accepted, 0u);
+  // The views really are alike: the verifier alone accepts them (geometry cannot tell), the
+  // odometry covariance check is what refuses them.
+  EXPECT_GT(closer.stats().rejected[int(loop::LoopRejection::kImplausible)], 0u);
+  const auto a = recordOf(corridor, 1, pose_at(10), pose_at(10), 0, Eigen::Isometry3d::Identity());
+  const auto b = recordOf(corridor, 2, pose_at(50), pose_at(50), 0, Eigen::Isometry3d::Identity());
+  EXPECT_TRUE(verifier.verify(*b, *candidateOf(*a)).accepted());
+}
+
+// Records of unrelated views along a line; every third one sits between two 5 mm steps (redundant).
+std::vector<std::unique_ptr<loop::LoopKeyframe>> lineOfRecords(int n) {
+  std::vector<std::unique_ptr<loop::LoopKeyframe>> records;
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  for (int k = 0; k < n; ++k) {
+    Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+    if (k > 0) step.translation() = Eigen::Vector3d(k % 3 == 0 ? 0.1 : 0.005, 0, 0);
+    T = T * step;
+    auto r = std::make_unique<loop::LoopKeyframe>();
+    const View view = unrelatedView(1000 + uint64_t(k), 300);
+    loop::fillLoopFeatures(*view.features, r.get());
+    r->id = uint32_t(k + 1);
+    r->previous_id = k > 0 ? uint32_t(k) : 0;
+    r->T_previous_this = step;
+    r->T_world_cam = T;
+    records.push_back(std::move(r));
+  }
+  return records;
+}
+
+TEST(LoopCloser, CapacityCullsTheMostRedundantKeyframesAndStaysBounded) {
+  loop::LoopCloserOptions options;
+  options.capacity = 20;
+  loop::LoopCloser closer = makeCloser(options);
+  const auto records = lineOfRecords(60);
+  for (int k = 0; k < 60; ++k) {
+    (void)closer.addKeyframe(*records[std::size_t(k)]);
+    EXPECT_LE(closer.size(), 20u);
+    if (k == 29) {
+      // 10 culls so far, all of them keyframes between two 5 mm steps (id k + 1 with k % 3 == 1).
+      EXPECT_EQ(closer.stats().culled, 10u);
+      int redundant_culled = 0;
+      Eigen::Isometry3d T;
+      for (int j = 0; j < 29; ++j) {
+        if (!closer.pose(uint32_t(j + 1), &T)) redundant_culled += j % 3 == 1;
+      }
+      EXPECT_EQ(redundant_culled, 10);
+    }
+  }
+  EXPECT_EQ(closer.size(), 20u);
+  EXPECT_EQ(closer.stats().culled, 40u);
+  EXPECT_EQ(closer.stats().peak_graph_nodes, 20u);
+  Eigen::Isometry3d T;
+  EXPECT_TRUE(closer.pose(1, &T));   // the first (gauge) keyframe is never culled
+  EXPECT_TRUE(closer.pose(60, &T));  // nor the newest
+  EXPECT_NEAR(T.translation().x(), records.back()->T_world_cam.translation().x(), 1e-12);
+  EXPECT_GT(closer.memoryBytes(), 20 * sizeof(loop::LoopCandidate));
+}
+
+TEST(LoopCloser, AddingKeyframesAllocatesNothing) {
+  loop::LoopCloserOptions options;
+  options.capacity = 20;
+  loop::LoopCloser closer = makeCloser(options);
+  const auto records = lineOfRecords(60);
+  const uint64_t before = allocationCount();
+  for (const auto& r : records) (void)closer.addKeyframe(*r);
+  EXPECT_EQ(allocationCount() - before, 0u);
+  EXPECT_EQ(closer.stats().culled, 40u);
+  EXPECT_GT(closer.stats().queries, 0u);
+}
+
+}  // namespace
+}  // namespace plumb::test
+
+namespace plumb::test {
+namespace {
+
+// The reserved stores are not written at construction; makeResidentStep() maps them a slice at a
+// time without changing a byte: a closer stepped to full residency between keyframes closes the
+// same loops with the same poses as one never stepped.
+TEST(LoopCloser, ResidencyStepsChangeNothingAndFinish) {
+  const Scene scene = cylinderScene(21, 6000, 3.5);
+  constexpr int kPerLap = 100, kTotal = 130;
+  auto pose_at = [&](int k) { return outwardPose(2 * M_PI * k / kPerLap, 1.0); };
+  loop::LoopCloserOptions options;
+  loop::LoopCloser stepped = makeCloser(options), plain = makeCloser(options);
+  const std::size_t queued = stepped.residentPendingBytes();
+  // records (129 x ~37.5 KB) + postings + H and factor: most of memoryBytes().
+  EXPECT_GT(queued, stepped.memoryBytes() / 2);
+  EXPECT_LE(queued, stepped.memoryBytes());
+  Eigen::Isometry3d T_odometry = pose_at(0);
+  std::size_t pending = queued;
+  int steps_to_finish = 0;
+  for (int k = 0; k < kTotal; ++k) {
+    Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+    if (k > 0) {
+      step = driftedStep(pose_at(k - 1).inverse() * pose_at(k));
+      T_odometry = T_odometry * step;
+    }
+    const auto record = recordOf(scene, uint32_t(k + 1), pose_at(k), T_odometry, k > 0 ? uint32_t(k) : 0, step);
+    EXPECT_EQ(stepped.addKeyframe(*record), plain.addKeyframe(*record)) << "keyframe " << k;
+    if (pending > 0) {
+      const std::size_t now = stepped.makeResidentStep(std::size_t(1) << 20);
+      EXPECT_EQ(now, pending > (std::size_t(1) << 20) ? pending - (std::size_t(1) << 20) : 0u);
+      pending = now;
+      ++steps_to_finish;
+    }
+  }
+  EXPECT_EQ(stepped.residentPendingBytes(), 0u);
+  EXPECT_EQ(std::size_t(steps_to_finish), (queued + (std::size_t(1) << 20) - 1) >> 20);
+  EXPECT_EQ(plain.residentPendingBytes(), queued);  // nobody stepped it
+  ASSERT_GE(stepped.stats().loops_accepted, 1u);
+  EXPECT_EQ(stepped.stats().loops_accepted, plain.stats().loops_accepted);
+  for (int k = 0; k < kTotal; ++k) {
+    Eigen::Isometry3d a, b;
+    ASSERT_EQ(stepped.pose(uint32_t(k + 1), &a), plain.pose(uint32_t(k + 1), &b));
+    EXPECT_TRUE(a.matrix() == b.matrix()) << "keyframe " << k + 1;
+  }
+}
+
+}  // namespace
+}  // namespace plumb::test
+
+namespace plumb::test {
+namespace {
+
+// Do no harm (loop_context_check.h): a loop whose measurement contradicts the keyframes around
+// both sides is rolled back. Lap 2 of a circle with exact odometry; keyframe kFake's record holds
+// the view of a place kShift keyframes further on (as a repeated piece of furniture would look),
+// so verification measures a loop to that place: a 0.3 m / 18 deg jump. Plausibility is switched
+// off (its chi-square bound made huge) so that the jump reaches the graph; consistency and
+// cooldown are switched off so that this single keyframe is verified. The query's predecessors
+// and the candidate's neighbours see the true geometry: the correction makes their common points
+// reproject worse, and the loop is undone (no correction, graph as before, counted).
+struct FakeLoopRun {
+  bool fake_accepted = false;
+  uint64_t rolled_back = 0;
+  loop::LoopAuditEntry fake_entry;
+  double pose_change_m = 0;  // of the fake keyframe's graph pose, against its odometry
+};
+
+FakeLoopRun runFakeLoop(bool context_check) {
+  const Scene scene = cylinderScene(21, 6000, 3.5);
+  constexpr int kPerLap = 100, kFake = 112, kShift = 5;
+  auto pose_at = [&](int k) { return outwardPose(2 * M_PI * k / kPerLap, 1.0); };
+  loop::LoopCloserOptions options;
+  options.capacity = 256;
+  options.plausibility_chi2 = 1e12;
+  options.min_consistent = 1;
+  options.cooldown_keyframes = 0;
+  options.context_check = context_check;
+  loop::LoopCloser closer = makeCloser(options);
+  FakeLoopRun out;
+  for (int k = 0; k <= kFake; ++k) {
+    const Eigen::Isometry3d step = k > 0 ? pose_at(k - 1).inverse() * pose_at(k) : Eigen::Isometry3d::Identity();
+    const Eigen::Isometry3d seen = k == kFake ? pose_at(k + kShift) : pose_at(k);
+    const auto record = recordOf(scene, uint32_t(k + 1), seen, pose_at(k), k > 0 ? uint32_t(k) : 0, step);
+    const bool accepted = closer.addKeyframe(*record);
+    if (k == kFake) out.fake_accepted = accepted;
+  }
+  out.rolled_back = closer.stats().rejected[int(loop::LoopRejection::kRolledBack)];
+  for (const loop::LoopAuditEntry& e : closer.audit().entries()) {
+    if (e.query_id == uint32_t(kFake + 1) && e.ransac_inliers > 0) out.fake_entry = e;
+  }
+  Eigen::Isometry3d T;
+  EXPECT_TRUE(closer.pose(uint32_t(kFake + 1), &T));
+  out.pose_change_m = translationError(T, pose_at(kFake));
+  return out;
+}
+
+TEST(LoopCloser, ALoopThatMakesTheCovisibleLandmarksWorseIsRolledBack) {
+  const FakeLoopRun without = runFakeLoop(false);
+  // The mechanism matters: without the check the jump is applied.
+  ASSERT_TRUE(without.fake_accepted);
+  EXPECT_GT(without.pose_change_m, 0.03);
+  EXPECT_GT(without.fake_entry.correction_m, 0.2);
+
+  const FakeLoopRun with = runFakeLoop(true);
+  EXPECT_FALSE(with.fake_accepted);
+  EXPECT_GE(with.rolled_back, 1u);
+  EXPECT_EQ(with.fake_entry.outcome, loop::LoopRejection::kRolledBack);
+  EXPECT_GT(with.fake_entry.context_matches, 100);
+  EXPECT_GT(with.fake_entry.context_cost_after, 1.5 * with.fake_entry.context_cost_before);
+  EXPECT_LT(with.pose_change_m, 1e-6);  // the graph is as it was
+}
+
+}  // namespace
+}  // namespace plumb::test
