@@ -10,7 +10,7 @@
 // Every error names the flag, the value and what was expected, and is reported by the command with
 // exit code 2 (kExitUsage). values() lists every flag with its value (given or default): what
 // `plumb run --stats` records, so a run can be reproduced from its statistics.
-// Adding a flag is one line in the command's table (see tools/run_command.cpp).
+// Adding a flag is one line in the command's table (see runFlagTable in tools/run_parse.cpp).
 #include <cstdint>
 #include <string>
 #include <utility>

@@ -4,7 +4,7 @@
 //
 // Wire order: base fields sorted by type size, largest first (stable among equal sizes), then the
 // extension fields in declaration order. CRC_EXTRA hashes the base fields only (see
-// docs/MAVLINK.md; tests/mavlink recomputes both values from the field lists).
+// docs/MAVLINK.md; tests/drivers/mavlink recomputes both values from the field lists).
 //
 //   HEARTBEAT #0, 9 bytes, CRC_EXTRA 50
 //     0 custom_mode uint32 | 4 type | 5 autopilot | 6 base_mode | 7 system_status |

@@ -7,7 +7,7 @@
 // allocated in the constructor for the camera's image size. In steady state extract() makes no
 // heap allocation of its own; the only allocating calls are inside OpenCV's line segment detector
 // (cv::LineSegmentDetector::detect builds internal lists) — documented in docs/FRONTEND.md and
-// measured by tests/pipeline/allocation_test.cpp.
+// measured by tests/pipeline/frontend/allocation_test.cpp.
 //
 // Not thread-safe: one extractor per thread.
 #include <memory>

@@ -40,7 +40,7 @@ struct Descriptor256 {
 // in matching and loop verification on head250), so there the count is SSE2 bit-slicing: bits
 // summed in pairs, nibbles, bytes, then the bytes of each half by psadbw (~30 instructions for
 // all 256 bits). aarch64 (NEON cnt) and -mpopcnt builds keep the builtin, which is inline there.
-// tests/pipeline/frontend_kernels_test.cpp checks it against a bit-by-bit count.
+// tests/pipeline/frontend/frontend_kernels_test.cpp checks it against a bit-by-bit count.
 inline int hammingDistance(const Descriptor256& a, const Descriptor256& b) {
 #if defined(__SSE2__) && !defined(__POPCNT__)
   const __m128i* pa = reinterpret_cast<const __m128i*>(a.words.data());

@@ -1,6 +1,6 @@
 // plumb's viewer page (docs/VIEWER.md): connects to the server that served it (the Foxglove
 // WebSocket protocol on the same port) and draws what `plumb run --serve` or `plumb view` sends.
-// window.plumbViewer exposes counters for tests (tests/viewer_node/page_test.js).
+// window.plumbViewer exposes counters for tests (tests/viewer_node/page_check.js).
 import { FoxgloveClient } from './foxglove_client.js';
 import { Scene } from './scene.js';
 
