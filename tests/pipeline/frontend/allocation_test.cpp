@@ -9,7 +9,7 @@
 #include "pipeline/frontend/image_pyramid.h"
 #include "pipeline/odometry/matcher.h"
 #include "platform/allocation_counter.h"
-#include "tests/pipeline/frontend/frontend_test_support.h"
+#include "tests/pipeline/frontend_test_support.h"
 
 namespace plumb {
 namespace {

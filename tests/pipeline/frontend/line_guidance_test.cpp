@@ -17,7 +17,7 @@
 #include "pipeline/frontend/feature_extractor.h"
 #include "pipeline/frontend/line_extractor.h"
 #include "pipeline/frontend/line_fit3d.h"
-#include "tests/pipeline/frontend/frontend_test_support.h"
+#include "tests/pipeline/frontend_test_support.h"
 
 namespace plumb {
 namespace {

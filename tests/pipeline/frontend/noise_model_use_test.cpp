@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "pipeline/frontend/feature_extractor.h"
-#include "tests/pipeline/frontend/frontend_test_support.h"
+#include "tests/pipeline/frontend_test_support.h"
 
 namespace plumb {
 namespace {

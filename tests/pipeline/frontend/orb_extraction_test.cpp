@@ -9,7 +9,7 @@
 
 #include "pipeline/frontend/feature_extractor.h"
 #include "pipeline/frontend/orb_fast.h"
-#include "tests/pipeline/frontend/frontend_test_support.h"
+#include "tests/pipeline/frontend_test_support.h"
 
 namespace plumb {
 namespace {

@@ -12,7 +12,7 @@
 
 #include "pipeline/frontend/feature_extractor.h"
 #include "pipeline/odometry/matcher.h"
-#include "tests/pipeline/frontend/frontend_test_support.h"
+#include "tests/pipeline/frontend_test_support.h"
 
 namespace plumb {
 namespace {
