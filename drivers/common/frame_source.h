@@ -54,6 +54,9 @@ class FrameSource {
   // A flag the caller sets to end the run (SIGINT): a live source that blocks (reconnecting with
   // backoff) checks it and returns kNoFrame soon after. nullptr = none. Wrappers forward it.
   virtual void setStopFlag(const std::atomic<bool>* stop) { (void)stop; }
+  // A hint, from any thread, that the device may be back (a USB camera arrived): a live source
+  // waiting to reconnect tries now rather than after its backoff. Wrappers forward it.
+  virtual void wakeReconnect() {}
 };
 
 }  // namespace plumb

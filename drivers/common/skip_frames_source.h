@@ -40,6 +40,7 @@ class SkipFramesSource : public FrameSource {
   SourceDamage damage() const override { return inner_->damage(); }
   std::string healthReport() const override { return inner_->healthReport(); }
   void setStopFlag(const std::atomic<bool>* stop) override { inner_->setStopFlag(stop); }
+  void wakeReconnect() override { inner_->wakeReconnect(); }
 
  private:
   std::unique_ptr<FrameSource> inner_;

@@ -14,6 +14,7 @@ const char* eventName(SourceEventKind kind) {
     case SourceEventKind::kReconnected: return "reconnected";
     case SourceEventKind::kGaveUp: return "gave up";
     case SourceEventKind::kGap: return "frames missing";
+    case SourceEventKind::kWoken: return "woken by a hot-plug arrival";
   }
   return "?";
 }
@@ -75,8 +76,26 @@ SourceResult ResilientSource::next(RgbdImage& out) {
   return SourceResult::kError;
 }
 
+void ResilientSource::sleepBackoff(int64_t backoff_ns) {
+  if (options_.wake_slice_ns <= 0) {
+    clock_.sleepForNs(backoff_ns);
+    return;
+  }
+  const int64_t until_ns = clock_.nowNs() + backoff_ns;
+  for (int64_t now_ns = clock_.nowNs(); now_ns < until_ns; now_ns = clock_.nowNs()) {
+    if (wake_.exchange(false, std::memory_order_relaxed)) {
+      ++stats_.hotplug_wakeups;
+      record(SourceEventKind::kWoken);
+      return;
+    }
+    if (stopRequested()) return;
+    clock_.sleepForNs(std::min(options_.wake_slice_ns, until_ns - now_ns));
+  }
+}
+
 bool ResilientSource::recover() {
   const int64_t failed_at_ns = clock_.nowNs();
+  wake_.store(false, std::memory_order_relaxed);  // arrivals before the failure say nothing
   int64_t backoff_ns = options_.initial_backoff_ns;
   for (int attempt = 1; options_.max_reopen_attempts == 0 || attempt <= options_.max_reopen_attempts;
        ++attempt) {
@@ -96,7 +115,7 @@ bool ResilientSource::recover() {
     ++stats_.reopen_failures;
     stats_.last_error = st.message();
     record(SourceEventKind::kReopenFailed);
-    clock_.sleepForNs(backoff_ns);
+    sleepBackoff(backoff_ns);
     backoff_ns = std::min<int64_t>(options_.max_backoff_ns,
                                    static_cast<int64_t>(backoff_ns * options_.backoff_multiplier));
   }
@@ -112,10 +131,11 @@ std::string ResilientSource::healthReport() const {
   char line[256];
   std::snprintf(line, sizeof line,
                 "source: errors %llu, stall timeouts %llu, reconnects %llu (%.3f s disconnected, %llu failed "
-                "reopens), frames missing %llu in %llu gaps",
+                "reopens, %llu hot-plug wake-ups), frames missing %llu in %llu gaps",
                 static_cast<unsigned long long>(stats_.errors), static_cast<unsigned long long>(stats_.stall_timeouts),
                 static_cast<unsigned long long>(stats_.reconnects), stats_.time_disconnected_ns * 1e-9,
                 static_cast<unsigned long long>(stats_.reopen_failures),
+                static_cast<unsigned long long>(stats_.hotplug_wakeups),
                 static_cast<unsigned long long>(stats_.frames_missing), static_cast<unsigned long long>(stats_.gaps));
   const std::string inner = inner_->healthReport();
   std::string text = inner.empty() ? std::string(line) : std::string(line) + "; " + inner;

@@ -6,6 +6,7 @@
 //
 // next() blocks while reconnecting (sleeping through the injected clock), which is what a capture
 // thread wants; it returns kError only when max_reopen_attempts is exhausted.
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -24,9 +25,13 @@ struct ResilientSourceOptions {
   // No frame for this long (only kNoFrame results) counts as a failure and triggers a reopen.
   // 0 disables it. 3 s is ~100 frames at 30 Hz: far beyond any healthy USB hiccup.
   int64_t stall_timeout_ns = 3'000'000'000;
+  // > 0: backoff sleeps are cut into slices this long, and end early when wakeReconnect() was
+  // called (a USB arrival) or a stop was requested. 0: whole sleeps (what the tests' virtual clock
+  // schedule checks); sources opened from a spec use 20 ms.
+  int64_t wake_slice_ns = 0;
 };
 
-enum class SourceEventKind { kError, kStallTimeout, kReopenFailed, kReconnected, kGaveUp, kGap };
+enum class SourceEventKind { kError, kStallTimeout, kReopenFailed, kReconnected, kGaveUp, kGap, kWoken };
 
 struct SourceEvent {
   int64_t t_ns = 0;           // clock time of the event
@@ -45,6 +50,7 @@ struct ResilienceStats {
   uint64_t reopen_attempts = 0;
   uint64_t reopen_failures = 0;
   uint64_t reconnects = 0;
+  uint64_t hotplug_wakeups = 0;      // backoff sleeps cut short by wakeReconnect() (USB arrival)
   int64_t time_disconnected_ns = 0;  // summed from failure to successful reopen
   // The first kMaxEvents events (bounded: a flapping sensor must not grow memory).
   static constexpr std::size_t kMaxEvents = 64;
@@ -74,6 +80,9 @@ class ResilientSource : public FrameSource {
     stop_ = stop;
     inner_->setStopFlag(stop);
   }
+  // Thread-safe: the next reopen attempt of a reconnection in progress (or starting) happens now
+  // instead of after its backoff (with wake_slice_ns > 0).
+  void wakeReconnect() override { wake_.store(true, std::memory_order_relaxed); }
 
   const ResilienceStats& stats() const { return stats_; }
   // One line per event ("t=1.250s error: ..."), for run reports.
@@ -82,6 +91,8 @@ class ResilientSource : public FrameSource {
  private:
   // Reopens with backoff; true when the source is back.
   bool recover();
+  // The backoff before the next reopen attempt; ends early on a wake-up or a stop request.
+  void sleepBackoff(int64_t backoff_ns);
   void record(SourceEventKind kind, uint64_t frames = 0);
 
   std::unique_ptr<FrameSource> inner_;
@@ -90,6 +101,7 @@ class ResilientSource : public FrameSource {
   ResilienceStats stats_;
   Status error_;
   const std::atomic<bool>* stop_ = nullptr;
+  std::atomic<bool> wake_{false};
   bool stopRequested() const { return stop_ != nullptr && stop_->load(std::memory_order_relaxed); }
   bool have_last_sequence_ = false;
   uint64_t last_sequence_ = 0;

@@ -9,6 +9,10 @@
 #include "drivers/recording/paced_source.h"
 #include "drivers/recording/recording_source.h"
 #include "drivers/v4l2/v4l2_source.h"
+#ifdef PLUMB_HAVE_LIBUSB
+#include "drivers/usb/libusb_backend.h"
+#include "drivers/usb/usb_arrival_waker.h"
+#endif
 
 namespace plumb {
 namespace {
@@ -18,8 +22,52 @@ bool endsWith(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
+#ifdef PLUMB_HAVE_LIBUSB
+// A supervised live source with a libusb hot-plug listener: a camera arriving wakes a
+// reconnection in progress (UsbArrivalWaker). Everything else is the supervised source's.
+class HotplugWakingSource : public FrameSource {
+ public:
+  HotplugWakingSource(std::unique_ptr<FrameSource> supervised, std::unique_ptr<UsbArrivalWaker> waker)
+      : inner_(std::move(supervised)), waker_(std::move(waker)) {}
+  ~HotplugWakingSource() override { waker_.reset(); }  // the listener goes before the source it wakes
+  SourceResult next(RgbdImage& out) override { return inner_->next(out); }
+  const PinholeCamera& camera() const override { return inner_->camera(); }
+  std::string describe() const override { return inner_->describe(); }
+  const Status& lastError() const override { return inner_->lastError(); }
+  Status reopen() override { return inner_->reopen(); }
+  bool isLive() const override { return true; }
+  std::string healthReport() const override {
+    const std::string report = inner_->healthReport();
+    const std::size_t end_of_summary = report.find('\n');
+    return report.substr(0, end_of_summary) + "; usb: cameras arrived " + std::to_string(waker_->arrivals()) +
+           (end_of_summary == std::string::npos ? "" : report.substr(end_of_summary));
+  }
+  void setStopFlag(const std::atomic<bool>* stop) override { inner_->setStopFlag(stop); }
+  void wakeReconnect() override { inner_->wakeReconnect(); }
+
+ private:
+  std::unique_ptr<FrameSource> inner_;
+  std::unique_ptr<UsbArrivalWaker> waker_;
+};
+#endif
+
+// Live sources are supervised (reopened with backoff); where libusb reports hot-plug events, a
+// camera arriving makes the next reopen attempt happen at once.
 std::unique_ptr<FrameSource> supervised(std::unique_ptr<FrameSource> live) {
-  return std::make_unique<ResilientSource>(std::move(live), ResilientSourceOptions{});
+  ResilientSourceOptions options;
+  options.wake_slice_ns = 20'000'000;
+  auto resilient = std::make_unique<ResilientSource>(std::move(live), options);
+#ifdef PLUMB_HAVE_LIBUSB
+  std::unique_ptr<UsbBackend> backend;
+  std::unique_ptr<UsbArrivalWaker> waker;
+  ResilientSource* wake_target = resilient.get();
+  if (openLibusbBackend(&backend).ok() &&
+      UsbArrivalWaker::create(std::move(backend), [wake_target] { wake_target->wakeReconnect(); }, &waker).ok()) {
+    waker->startThread();
+    return std::make_unique<HotplugWakingSource>(std::move(resilient), std::move(waker));
+  }
+#endif
+  return resilient;  // no hot-plug events here: reconnection on the backoff schedule alone
 }
 
 Status openRecording(const std::string& path, const std::string& camera_spec,

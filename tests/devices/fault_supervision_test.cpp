@@ -195,3 +195,37 @@ TEST(FaultSupervision, WithoutAStopASilentLiveSourceIsAskedAgain) {
 
 }  // namespace
 }  // namespace plumb
+
+// A USB arrival cuts the backoff short: the next reopen attempt happens at once.
+namespace plumb {
+namespace {
+
+TEST(FaultSupervision, AHotplugWakeUpEndsTheBackoffEarly) {
+  ResilientSource* target = nullptr;
+  class WakingClock : public VirtualClock {
+   public:
+    explicit WakingClock(ResilientSource** target) : target_(target) {}
+    void sleepForNs(int64_t ns) override {
+      VirtualClock::sleepForNs(ns);
+      if (sleeps_ns.size() == 1) (*target_)->wakeReconnect();  // the camera arrives 20 ms in
+    }
+    ResilientSource** target_;
+  } clock(&target);
+  auto inner = std::make_unique<test::VectorSource>(test::makeNoiseFrames(9, 8, 6, 10), test::smallCamera(8, 6));
+  auto faulty = std::make_unique<FaultInjectingSource>(
+      std::move(inner), std::vector<FaultEvent>{{3, FaultKind::kDisconnect, 2, /*failed reopens*/ 1}});
+  ResilientSourceOptions options;
+  options.initial_backoff_ns = 500'000'000;
+  options.wake_slice_ns = 20'000'000;
+  ResilientSource supervised(std::move(faulty), options, clock);
+  target = &supervised;
+  const std::vector<uint64_t> delivered = drain(supervised);
+  EXPECT_EQ(delivered.size(), 8u);
+  EXPECT_EQ(clock.sleeps_ns, (std::vector<int64_t>{20'000'000})) << "woken after the first 20 ms slice";
+  EXPECT_EQ(supervised.stats().hotplug_wakeups, 1u);
+  EXPECT_EQ(supervised.stats().reconnects, 1u);
+  EXPECT_NE(supervised.describeEvents().find("woken by a hot-plug arrival"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace plumb

@@ -5,6 +5,7 @@
 #ifdef PLUMB_HAVE_LIBUSB
 #include "drivers/usb/camera_monitor.h"
 #include "drivers/usb/libusb_backend.h"
+#include "drivers/usb/usb_arrival_waker.h"
 
 namespace plumb {
 namespace {
@@ -65,6 +66,30 @@ UsbDeviceId device(uint16_t vid, uint16_t pid, const std::string& port) {
   id.bus = static_cast<uint8_t>(port[0] - '0');
   id.port_path = port;
   return id;
+}
+
+TEST(UsbArrivalWaker, EveryCameraArrivalAndOnlyThatWakes) {
+  auto backend = std::make_unique<FakeUsbBackend>();
+  FakeUsbBackend* fake = backend.get();
+  int wakes = 0;
+  std::unique_ptr<UsbArrivalWaker> waker;
+  ASSERT_TRUE(UsbArrivalWaker::create(std::move(backend), [&] { ++wakes; }, &waker).ok());
+  ASSERT_NE(fake->handler, nullptr);
+  fake->handler->onArrived(device(0x046d, 0xc52b, "1-3"));  // a mouse
+  EXPECT_EQ(wakes, 0);
+  fake->handler->onArrived(device(0x8086, 0x0b07, "2-1"));  // a D435
+  EXPECT_EQ(wakes, 1);
+  fake->handler->onLeft(device(0x8086, 0x0b07, "2-1"));
+  fake->handler->onArrived(device(0x8086, 0x0b07, "2-1"));  // replugged
+  EXPECT_EQ(wakes, 2);
+  EXPECT_EQ(waker->arrivals(), 2u);
+  EXPECT_TRUE(waker->pollOnce(0).ok());
+
+  auto without_hotplug = std::make_unique<FakeUsbBackend>();
+  without_hotplug->hotplug = false;
+  std::unique_ptr<UsbArrivalWaker> none;
+  EXPECT_FALSE(UsbArrivalWaker::create(std::move(without_hotplug), [&] { ++wakes; }, &none).ok());
+  EXPECT_EQ(none, nullptr);
 }
 
 TEST(CameraMonitor, ScanKeepsOnlyCamerasAndSaysWhichSourceOpensThem) {
