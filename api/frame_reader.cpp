@@ -24,6 +24,12 @@ Status FrameReader::open(const std::string& spec, const std::string& camera, std
   auto impl = std::make_unique<Impl>();
   const Status st = fromStatus(openFrameSource(spec, camera, &impl->source));
   if (!st.ok) return st;
+  // Its frames would go to Odometry as registered depth with a camera that cannot say otherwise.
+  if (!impl->source->camera().depthRegistered()) {
+    return Status::Error(impl->source->describe() +
+                         ": its depth is not registered to colour (the camera describes a depth camera); the API "
+                         "takes registered depth only (`plumb run` registers it)");
+  }
   impl->camera = toValues(impl->source->camera());
   out->reset(new FrameReader(std::move(impl)));
   return Status::Ok();

@@ -1,6 +1,8 @@
-// plumb::api::Odometry: the public push-style odometry over OdometryStepper (the runner's stages,
-// lock-step). Copies the caller's frame into the one slot, steps, and queues finished poses.
+// plumb::api::Odometry: the public push-style odometry over a RunSession (pipeline/run/run_session.h:
+// the runner's stages and end-of-run protocol, stepped lock-step). Copies the caller's frame into
+// the session's slot, steps, and queues finished poses.
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -8,7 +10,7 @@
 #include "api/api_convert.h"
 #include "api/plumb/odometry.h"
 #include "drivers/dataset/camera_presets.h"
-#include "pipeline/run/odometry_stepper.h"
+#include "pipeline/run/run_session.h"
 #include "sensor/rgbd_image.h"
 
 namespace plumb::api {
@@ -33,6 +35,12 @@ Status resolveCamera(const CameraSpec& spec, CameraValues* out) {
     if (spec.name_or_file.empty()) return Status::Error("camera: give a preset (tum1 tum2 tum3 icl), a file or values");
     const ::plumb::Status st = cameraFromSpec(spec.name_or_file, &camera);
     if (!st.ok()) return fromStatus(st);
+    // CameraValues (the installed header) has no depth camera: taking such a file would read
+    // unregistered depth as registered.
+    if (!camera.depthRegistered()) {
+      return Status::Error(spec.name_or_file + ": describes a depth camera not registered to colour; the API takes "
+                           "registered depth only (`plumb run` registers it)");
+    }
   }
   *out = toValues(camera);
   return Status::Ok();
@@ -44,7 +52,11 @@ namespace {
 // delay and a margin, so a caller who drains after every track() never makes it grow.
 class FinishedQueue final : public OdometrySink {
  public:
-  explicit FinishedQueue(std::size_t capacity) : ring_(capacity) {}
+  // A pose finishes output_delay frames after it was tracked (at finish() all of them at once).
+  ::plumb::Status begin(const OdometrySystem& system) override {
+    ring_.assign(std::size_t(system.options().output_delay_frames) + 64, FinishedPose{});
+    return ::plumb::Status::Ok();
+  }
   ::plumb::Status onFinishedFrame(const FinishedFrame& frame) override {
     if (count_ == ring_.size()) grow();
     ring_[(head_ + count_) % ring_.size()] = toFinished(frame);
@@ -67,7 +79,7 @@ class FinishedQueue final : public OdometrySink {
     ring_.swap(bigger);
     head_ = 0;
   }
-  std::vector<FinishedPose> ring_;
+  std::vector<FinishedPose> ring_ = std::vector<FinishedPose>(1);  // begin() sizes it
   std::size_t head_ = 0, count_ = 0;
 };
 
@@ -75,9 +87,8 @@ class FinishedQueue final : public OdometrySink {
 
 struct Odometry::Impl {
   CameraValues camera;
-  std::unique_ptr<OdometrySystem> system;
   std::unique_ptr<FinishedQueue> finished;
-  std::unique_ptr<OdometryStepper> stepper;
+  std::unique_ptr<RunSession> session;
   bool finished_input = false;
   bool has_previous_timestamp = false;
   double previous_timestamp_s = 0;
@@ -91,14 +102,16 @@ Status Odometry::create(const OdometryConfig& config, std::unique_ptr<Odometry>*
   Status st = resolveCamera(config.camera, &impl->camera);
   if (!st.ok) return st;
   const SystemOptions options = systemOptions(config.lines, config.line_samples, config.output_delay_frames);
-  st = fromStatus(OdometrySystem::create(toCamera(impl->camera), options, &impl->system));
+  impl->finished = std::make_unique<FinishedQueue>();
+  // The runner's default options (deterministic, loop closing with its defaults): the same bytes
+  // as `plumb run`.
+  OdometryRunOptions run_options;
+  run_options.loop_closing = config.loop_closing;
+  // Warm-up far away: the allocation bookkeeping is the runner's; callers measure themselves.
+  run_options.warmup_frames = UINT64_MAX;
+  st = fromStatus(
+      RunSession::create(toCamera(impl->camera), options, *impl->finished, run_options, &impl->session));
   if (!st.ok) return st;
-  // A pose finishes output_delay frames after it was tracked; at finish() all of them at once.
-  impl->finished = std::make_unique<FinishedQueue>(std::size_t(options.output_delay_frames) + 64);
-  // Loop closing with the runner's default options, lock-step: the same bytes as `plumb run`.
-  const OdometryRunOptions run_defaults;
-  impl->stepper = std::make_unique<OdometryStepper>(*impl->system, *impl->finished,
-                                                    config.loop_closing ? &run_defaults.loop : nullptr);
   out->reset(new Odometry(std::move(impl)));
   return Status::Ok();
 }
@@ -146,7 +159,7 @@ Status Odometry::track(const FrameView& frame, TrackOutput* out) {
   if (!st.ok) return st;
   impl_->has_previous_timestamp = true;
   impl_->previous_timestamp_s = frame.timestamp_s;
-  RgbdImage& image = impl_->stepper->slot().image;
+  RgbdImage& image = impl_->session->slot().image;
   const int w = frame.width, h = frame.height;
   const std::size_t color_stride = frame.color_stride ? frame.color_stride : std::size_t(w) * 3;
   const std::size_t depth_stride = frame.depth_stride ? frame.depth_stride : std::size_t(w) * 2;
@@ -167,9 +180,9 @@ Status Odometry::track(const FrameView& frame, TrackOutput* out) {
   }
   image.timestamp_s = frame.timestamp_s;
   image.depth_timestamp_s = frame.timestamp_s;
-  st = fromStatus(impl_->stepper->step());
+  st = fromStatus(impl_->session->step());
   if (!st.ok) return st;
-  if (out != nullptr) toTrackOutput(impl_->stepper->slot().tracked->output, out);
+  if (out != nullptr) toTrackOutput(impl_->session->slot().tracked->output, out);
   return Status::Ok();
 }
 
@@ -178,11 +191,11 @@ bool Odometry::popFinished(FinishedPose* out) { return impl_->finished->pop(out)
 Status Odometry::finish() {
   if (impl_->finished_input) return Status::Ok();
   impl_->finished_input = true;
-  return fromStatus(impl_->stepper->finish());
+  return fromStatus(impl_->session->finish());
 }
 
 Counters Odometry::counters() const {
-  return toCounters(impl_->system->stats(), impl_->stepper->frames(), impl_->stepper->extractionFailures());
+  return toCounters(impl_->session->system().stats(), impl_->session->frames(), impl_->session->extractionFailures());
 }
 
 }  // namespace plumb::api

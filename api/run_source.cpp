@@ -45,16 +45,13 @@ Status runSource(const RunConfig& config, const std::function<void(const TrackOu
   std::unique_ptr<FrameSource> source;
   st = fromStatus(openFrameSource(config.source, config.camera, &source));
   if (!st.ok) return st;
-  std::unique_ptr<OdometrySystem> system;
-  st = fromStatus(OdometrySystem::create(
-      source->camera(), systemOptions(config.lines, config.line_samples, config.output_delay_frames), &system));
-  if (!st.ok) return st;
   CallbackSink sink(on_pose, on_finished);
   SourceCapture capture(*source);
   OdometryRunResult result;
-  st = fromStatus(runOdometry(capture, *system, sink, run_options, &result));
+  st = fromStatus(runOdometry(capture, systemOptions(config.lines, config.line_samples, config.output_delay_frames),
+                              sink, run_options, &result));
   if (summary != nullptr) {
-    summary->counters = toCounters(system->stats(), result.frames, result.extraction_failures);
+    summary->counters = toCounters(result.odometry, result.frames, result.extraction_failures);
     summary->frames_dropped = result.frames_dropped;
     summary->frames_per_second = result.report.framesPerSecond();
   }

@@ -36,5 +36,17 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       &plumb::PinholeCamera::rolling_shutter_readout_s};
   for (auto field : reals) FUZZ_CHECK(sameBits(reread.*field, camera.*field));
   FUZZ_CHECK(reread.width == camera.width && reread.height == camera.height);
+  FUZZ_CHECK(reread.depth_camera.has_value() == camera.depth_camera.has_value());
+  if (camera.depth_camera) {
+    const plumb::DepthCamera& a = *camera.depth_camera;
+    const plumb::DepthCamera& b = *reread.depth_camera;
+    const double plumb::DepthCamera::*depth_reals[] = {
+        &plumb::DepthCamera::fx, &plumb::DepthCamera::fy, &plumb::DepthCamera::cx, &plumb::DepthCamera::cy,
+        &plumb::DepthCamera::k1, &plumb::DepthCamera::k2, &plumb::DepthCamera::p1, &plumb::DepthCamera::p2,
+        &plumb::DepthCamera::k3, &plumb::DepthCamera::qx, &plumb::DepthCamera::qy, &plumb::DepthCamera::qz,
+        &plumb::DepthCamera::qw, &plumb::DepthCamera::tx, &plumb::DepthCamera::ty, &plumb::DepthCamera::tz};
+    for (auto field : depth_reals) FUZZ_CHECK(sameBits(b.*field, a.*field));
+    FUZZ_CHECK(b.width == a.width && b.height == a.height);
+  }
   return 0;
 }

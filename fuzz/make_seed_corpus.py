@@ -80,6 +80,11 @@ def text_seeds():
     put("camera_file", "minimal.txt", "fx 525\nfy 525\ncx 319.5\ncy 239.5\n")
     put("camera_file", "full.txt", "fx 481.2\nfy -480\ncx 319.5\ncy 239.5  # ICL\nwidth 640\nheight 480\n"
         "depth_factor 1000\nbaseline 0.08\nrolling_shutter_readout 0.03\n")
+    put("camera_file", "unregistered_depth.txt", "fx 525\nfy 525\ncx 319.5\ncy 239.5\ndepth_factor 1000\n"
+        "depth_fx 287.5\ndepth_fy 287.5\ndepth_cx 157\ndepth_cy 121.5\ndepth_k1 -0.05\n"
+        "depth_width 320\ndepth_height 240\ndepth_to_colour_qx 0.0015\ndepth_to_colour_qy -0.004\n"
+        "depth_to_colour_qz 0.002\ndepth_to_colour_qw 0.99998775\ndepth_to_colour_tx 0.025\n"
+        "depth_to_colour_ty 0.001\ndepth_to_colour_tz -0.002\n")
     put("trajectory_reader", "groundtruth.txt", "\x03# ground truth trajectory\n# timestamp tx ty tz qx qy qz qw\n"
         "1305031098.6659 1.3563 0.6305 1.6380 0.6132 0.5962 -0.3311 -0.3986\n"
         "1305031098.6758 1.3543 0.6306 1.6360 0.6129 0.5966 -0.3316 -0.3980\n")

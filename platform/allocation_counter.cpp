@@ -10,9 +10,12 @@ namespace {
 std::atomic<uint64_t> g_allocations{0};
 std::atomic<uint64_t> g_deallocations{0};
 std::atomic<uint64_t> g_bytes{0};
+std::atomic<uint64_t> g_excluded_allocations{0};
+// Plain bool (constant-initialised): no TLS wrapper function, and set before the thread allocates.
+thread_local bool t_excluded = false;
 
 void* countedAlloc(std::size_t size, std::size_t alignment) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  (t_excluded ? g_excluded_allocations : g_allocations).fetch_add(1, std::memory_order_relaxed);
   g_bytes.fetch_add(size, std::memory_order_relaxed);
   if (size == 0) size = 1;
   void* p = nullptr;
@@ -37,6 +40,8 @@ namespace plumb {
 uint64_t allocationCount() { return g_allocations.load(std::memory_order_relaxed); }
 uint64_t deallocationCount() { return g_deallocations.load(std::memory_order_relaxed); }
 uint64_t allocatedBytes() { return g_bytes.load(std::memory_order_relaxed); }
+void excludeThisThreadFromAllocationCount() { t_excluded = true; }
+uint64_t excludedAllocationCount() { return g_excluded_allocations.load(std::memory_order_relaxed); }
 }  // namespace plumb
 
 void* operator new(std::size_t size) {

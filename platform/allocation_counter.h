@@ -12,9 +12,16 @@
 
 namespace plumb {
 
-uint64_t allocationCount();    // operator new calls since start
+uint64_t allocationCount();    // operator new calls since start (threads excluded below not counted)
 uint64_t deallocationCount();  // operator delete calls (non-null) since start
-uint64_t allocatedBytes();     // bytes requested through operator new since start
+uint64_t allocatedBytes();     // bytes requested through operator new since start (every thread)
+
+// A thread that is no part of any frame path (the viewer's server thread, viewer/) calls this once
+// at its start: from then on its allocations go to excludedAllocationCount() instead, so
+// allocationCount() still proves the frame path allocates nothing while a viewer runs beside it.
+// What such a thread allocates is reported on its own, never hidden.
+void excludeThisThreadFromAllocationCount();
+uint64_t excludedAllocationCount();  // operator new calls on excluded threads since start
 
 // RAII helper: allocations made between construction and count().
 class AllocationScope {

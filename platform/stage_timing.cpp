@@ -1,6 +1,7 @@
 #include "platform/stage_timing.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 
@@ -20,7 +21,7 @@ double TimingSeries::percentile(double p) const {
   if (ms.empty()) return 0;
   std::vector<double> sorted = ms;
   std::sort(sorted.begin(), sorted.end());
-  const size_t i = std::min(sorted.size() - 1, static_cast<size_t>(p * (sorted.size() - 1) + 0.5));
+  const size_t i = std::min(sorted.size() - 1, static_cast<size_t>(std::llround(p * double(sorted.size() - 1))));
   return sorted[i];
 }
 

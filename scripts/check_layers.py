@@ -32,7 +32,10 @@ PRODUCT = ["platform", "runtime", "solver", "sensor", "pipeline/frontend", "pipe
 # api/: the public front door (<plumb/odometry.h>, the Python module) over everything below it;
 # no product folder uses it. examples/: separate projects built against an INSTALLED plumb
 # (find_package(plumb)), so they include only <plumb/...> and link only plumb::plumb.
-FIXED_LAYERS = PRODUCT + ["api", "examples", "tools", "tests/support", "bench", "fuzz"]
+# viewer/: watching a run (docs/VIEWER.md), over pipeline/run and drivers; only tools/, tests and
+# benchmarks use it (a product folder of its own that no other product folder may include).
+VIEWER = ["viewer"]
+FIXED_LAYERS = PRODUCT + VIEWER + ["api", "examples", "tools", "tests/support", "bench", "fuzz"]
 
 _PIPE = ["sensor", "solver", "runtime", "platform"]
 # Project folders a layer may include/link besides itself.
@@ -47,14 +50,15 @@ ALLOWED_LAYERS = {
     "pipeline/run": ["pipeline/loop", "pipeline/odometry", "pipeline/frontend"] + _PIPE,
     # solver/ for SE(3) maths only (output frame conventions, e.g. MAVLink's covariance).
     "drivers": ["sensor", "solver", "runtime", "platform"],
+    "viewer": PRODUCT,
     "api": PRODUCT,
     "examples": [],
-    "tools": PRODUCT,
+    "tools": PRODUCT + VIEWER,
     "tests/support": PRODUCT,
-    "tests/*": PRODUCT + ["api", "tests/support"],
+    "tests/*": PRODUCT + VIEWER + ["api", "tests/support"],
     # Benchmarks and fuzzers may share test scaffolding, but only what tests/support holds.
-    "bench": PRODUCT + ["tests/support"],
-    "fuzz": PRODUCT + ["tests/support"],
+    "bench": PRODUCT + VIEWER + ["tests/support"],
+    "fuzz": PRODUCT + VIEWER + ["tests/support"],
 }
 
 # Families of headers (and link items) that are not files of the tree.
@@ -94,6 +98,10 @@ def header_family(name):
         return "std"
     if name.endswith(".h") and name[:-2] in STD_C:
         return "std"
+    # The compiler's own SIMD intrinsics (x86 SSE/AVX, ARM NEON): part of the toolchain, like std.
+    if name in ("emmintrin.h", "xmmintrin.h", "pmmintrin.h", "tmmintrin.h", "smmintrin.h", "nmmintrin.h",
+                "immintrin.h", "arm_neon.h"):
+        return "std"
     if (name.endswith(".h") and name[:-2] in POSIX_H) or name.startswith(POSIX_DIRS):
         return "posix"
     if name.startswith(("Eigen/", "unsupported/Eigen/")):
@@ -120,6 +128,10 @@ def header_family(name):
         return "ceres"
     if name.startswith("pybind11/"):
         return "pybind11"
+    if name.startswith("websocketpp/"):
+        return "websocketpp"
+    if name == "asio.hpp" or name.startswith("asio/"):
+        return "asio"
     if name.startswith("plumb/"):
         return "plumb_installed"  # the installed public headers (examples/)
     return None
@@ -137,12 +149,14 @@ ALLOWED_FAMILIES = {
     "pipeline/loop": ["std", "eigen", "opencv_core", "opencv"],
     "pipeline/run": ["std", "eigen", "opencv_core", "opencv"],
     "drivers": _ALL_THIRD_PARTY,
+    "viewer": _ALL_THIRD_PARTY + ["websocketpp", "asio"],
     "api": _ALL_THIRD_PARTY + ["pybind11"],
     "examples": ["std", "eigen", "plumb_installed"],
     "tools": _ALL_THIRD_PARTY,
     "tests/support": _ALL_THIRD_PARTY + ["gtest"],
-    "tests/*": _ALL_THIRD_PARTY + ["gtest", "ceres"],  # Ceres: a test-only oracle
-    "bench": _ALL_THIRD_PARTY + ["ceres"],
+    # Ceres: a test-only oracle; websocketpp/asio: tests/viewer's client.
+    "tests/*": _ALL_THIRD_PARTY + ["gtest", "ceres", "websocketpp", "asio"],
+    "bench": _ALL_THIRD_PARTY + ["ceres", "websocketpp", "asio"],  # bench/viewer's clients
     "fuzz": _ALL_THIRD_PARTY + ["zlib"],  # zlib: re-deflating mutated PNGs
 }
 
@@ -750,6 +764,11 @@ class CMakeModel:
                 entry["links"].append((objects.group(1), where))
             elif "$<" in value:
                 continue  # other generator expressions select flags or configurations
+            elif value.startswith("${CMAKE_CURRENT_BINARY_DIR}/") and "${" not in value[28:]:
+                # A file this folder's build generates (viewer/'s embedded page): it belongs to the
+                # folder whose CMakeLists.txt makes it.
+                entry["sources"].append((os.path.normpath(os.path.join(directory, value[28:])).replace(
+                    os.sep, "/"), where))
             elif "${" in value:
                 self.problems.append((where[0], where[1], "source %s: a variable this check "
                                       "cannot see (set it in the same file)" % value))

@@ -20,6 +20,7 @@ PRODUCT_PACKAGES=(
   libeigen3-dev libopencv-core-dev libopencv-imgproc-dev libpng-dev libdeflate-dev
   libopenni2-dev libv4l-dev libusb-1.0-0-dev
   libjpeg62-turbo-dev  # MJPEG cameras and JPEG images in TUM folders (optional at build time)
+  libwebsocketpp-dev libasio-dev  # the viewer's server (plumb run --serve, plumb view; header-only)
 )
 # Tests, benchmarks and the Python module.
 TEST_PACKAGES=(
@@ -27,8 +28,11 @@ TEST_PACKAGES=(
   libgtest-dev libbenchmark-dev
   python3-dev python3-pybind11 pybind11-dev python3-numpy python3-pytest
   valgrind  # ctest instruction_budget (bench/instructions/; skipped without it)
+  libceres-dev  # plumb_bench_solver's and plumb_test_solver_ceres's oracle (never linked by the product)
   clang libclang-rt-14-dev  # fuzz targets (scripts/fuzz.sh): libFuzzer is in libclang-rt-14-dev
-  nodejs npm  # the independent MAVLink decoder of tests/mavlink_node (node-mavlink, pinned)
+  clang-tidy  # scripts/tidy.sh: bugprone and naming checks of .clang-tidy
+  nodejs npm  # tests/mavlink_node, tests/viewer_node (pinned npm packages); builds the viewer page
+  chromium    # the viewer page test (ctest viewer_page, headless, driven by playwright-core)
   # the virtual-machine camera bench (scripts/vm_camera_test.sh, ctest vm_camera).
   # The guest kernel (linux-image-amd64's linux-image-6.1.*), its linux-headers and the
   # v4l2loopback-dkms source are fetched by that script with `apt-get download` and unpacked into
@@ -65,10 +69,24 @@ else
   $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-if [ "$with_tests" = 1 ]; then
-  # node-mavlink for tests/mavlink_node, pinned by its package-lock.json.
-  here="$(cd "$(dirname "$0")/.." && pwd)"
-  if [ ! -f "$here/tests/mavlink_node/node_modules/node-mavlink/package.json" ]; then
-    npm ci --prefix "$here/tests/mavlink_node" --no-audit --no-fund
+# npm packages, each folder pinned by its package-lock.json (npm ci), where npm is installed:
+#   product: viewer/web (three.js and esbuild: the viewer page is bundled into `plumb` at build
+#            time; without npm `plumb` has no page and Foxglove/Lichtblick still work);
+#   tests:   tests/mavlink_node (node-mavlink: the independent MAVLink decoder), tests/viewer_node
+#            (@foxglove/ws-protocol, playwright-core, ws: the viewer's real-client tests).
+here="$(cd "$(dirname "$0")/.." && pwd)"
+npm_ci() {  # FOLDER MARKER_FILE
+  if [ ! -f "$here/$1/node_modules/$2" ]; then
+    npm ci --prefix "$here/$1" --no-audit --no-fund
   fi
+}
+if command -v npm >/dev/null 2>&1; then
+  npm_ci viewer/web three/package.json
+  if [ "$with_tests" = 1 ]; then
+    npm_ci tests/mavlink_node node-mavlink/package.json
+    npm_ci tests/viewer_node playwright-core/package.json
+  fi
+else
+  echo "install_deps: npm not found: plumb is built without its viewer page (Foxglove still works;" \
+       "install_deps.sh --tests installs nodejs and npm)"
 fi

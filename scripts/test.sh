@@ -6,7 +6,10 @@
 #      except the system area's long replays (`bash scripts/sanitize.sh` runs all of them);
 #   4. every parser's libFuzzer target for 20 s each with a fixed seed (scripts/fuzz.sh; skipped
 #      without clang);
-#   5. the aarch64 cross build and its unit tests under qemu (scripts/cross_aarch64.sh).
+#   5. clang-tidy (bugprone + naming, warnings as errors) on the leaf product folders platform/,
+#      runtime/, solver/, sensor/ (~2 min; scripts/tidy.sh with no folder argument checks every
+#      product folder, ~10 min on 2 cores: too much of CI's budget, run it before a merge);
+#   6. the aarch64 cross build and its unit tests under qemu (scripts/cross_aarch64.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 JOBS=$(nproc 2>/dev/null || echo 2)
@@ -30,7 +33,7 @@ elapsed "ThreadSanitizer done"
 
 echo "== AddressSanitizer + UBSan: every area but system (scripts/sanitize.sh) =="
 PRESET=asan-fast bash scripts/sanitize.sh platform runtime solver pipeline odometry loop drivers devices \
-  mavlink api tools mapfile
+  mavlink api tools mapfile viewer
 elapsed "AddressSanitizer done"
 
 echo "== Fuzzing: every parser, 20 s each (scripts/fuzz.sh) =="
@@ -41,7 +44,15 @@ else
 fi
 elapsed "fuzzing done"
 
-# 5. aarch64: cross build, every unit test under qemu and a replay compared with x86 (docs/EMBEDDED.md;
+echo "== clang-tidy: platform/ runtime/ solver/ sensor/ (scripts/tidy.sh) =="
+if command -v run-clang-tidy >/dev/null 2>&1; then
+  bash scripts/tidy.sh build 'platform|runtime|solver|sensor'
+else
+  echo "skipped: run-clang-tidy not found (scripts/install_deps.sh --tests installs clang-tidy)"
+fi
+elapsed "clang-tidy done"
+
+# 6. aarch64: cross build, every unit test under qemu and a replay compared with x86 (docs/EMBEDDED.md;
 #    ~20-25 min on 2 cores from cold, most of it the cross build). PLUMB_CROSS=0 skips it.
 if [ "${PLUMB_CROSS:-1}" = "1" ]; then
   echo "== aarch64 cross build, tests under qemu (scripts/cross_aarch64.sh) =="

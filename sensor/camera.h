@@ -11,10 +11,13 @@
 // ideal pinhole model.
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <tuple>
 
 #include <Eigen/Core>
+
+#include "sensor/depth_camera.h"
 
 namespace plumb {
 
@@ -34,6 +37,16 @@ struct PinholeCamera {
   // Rolling shutter: seconds from the first to the last image row's exposure; 0 = global shutter.
   // The tracker moves features to the middle row's time (pipeline/odometry/tracker_rolling_shutter.h).
   double rolling_shutter_readout_s = 0.0;
+  // Depth from a separate depth camera, not registered to this (colour) camera: its intrinsics,
+  // size and T_colour_depth. Empty (every preset): depth images are registered, camera-sized.
+  // Sources deliver such depth as the depth camera sees it (depthWidth() x depthHeight()); the
+  // pipeline registers it into this camera before extraction (docs/FRONTEND.md).
+  std::optional<DepthCamera> depth_camera;
+
+  bool depthRegistered() const { return !depth_camera.has_value(); }
+  // Size of the depth images a source delivers.
+  int depthWidth() const { return depth_camera ? depth_camera->width : width; }
+  int depthHeight() const { return depth_camera ? depth_camera->height : height; }
 
   bool hasDistortion() const { return k1 != 0 || k2 != 0 || p1 != 0 || p2 != 0 || k3 != 0; }
 
@@ -82,6 +95,12 @@ struct PinholeCamera {
   // point off the image, a focal length of 1e300 or 1e-300 pixels, a distortion of 1e6 or a readout
   // of 1e9 s is a typo or a hostile file, and accepting it tracks "ok" frames into nonsense.
   std::string validate() const;
+
+ private:
+  // The depth camera (depth_camera.h, plus the distortion bounds below), then one joint check:
+  // the centre of the depth camera's view at 2 m must land in the colour image, or the transform
+  // points the wrong way (colour-to-depth given for depth-to-colour) or belongs to another camera.
+  std::string validateDepthCamera() const;
 };
 
 // Plausibility bounds of PinholeCamera::validate (docs/DATA_FORMATS.md "Camera").
@@ -139,7 +158,46 @@ inline std::string PinholeCamera::validate() const {
     return "rolling_shutter_readout must be >= 0";
   if (rolling_shutter_readout_s > b.max_readout_s)
     return "rolling_shutter_readout " + text(rolling_shutter_readout_s) + " s beyond " + text(b.max_readout_s) + " s";
+  if (depth_camera) return validateDepthCamera();
   return "";
+}
+
+inline std::string PinholeCamera::validateDepthCamera() const {
+  const std::string problem = depth_camera->validate(kMaxImageSide);
+  if (!problem.empty()) return problem;
+  const DepthCamera& d = *depth_camera;
+  const CameraBounds& b = kCameraBounds;
+  if (std::abs(d.k1) > b.max_radial || std::abs(d.k2) > b.max_radial || std::abs(d.k3) > b.max_radial ||
+      std::abs(d.p1) > b.max_tangential || std::abs(d.p2) > b.max_tangential)
+    return "depth camera distortion beyond the colour camera's bounds (|k| <= " + std::to_string(int(b.max_radial)) +
+           ", |p| <= " + std::to_string(int(b.max_tangential)) + ")";
+  const Eigen::Vector3d P_depth((d.width / 2.0 - d.cx) / d.fx * 2.0, (d.height / 2.0 - d.cy) / d.fy * 2.0, 2.0);
+  const Eigen::Vector3d P_colour = d.T_colour_depth() * P_depth;
+  const Eigen::Vector2d px = P_colour.z() > 0 ? project(P_colour) : Eigen::Vector2d(-1e9, -1e9);
+  if (!inImage(px.x(), px.y())) {
+    return "the centre of the depth camera's view (at 2 m) falls outside the colour image, at (" +
+           std::to_string(px.x()) + ", " + std::to_string(px.y()) +
+           "): is depth_to_colour the colour-to-depth transform, or another camera's?";
+  }
+  return "";
+}
+
+// The lens of a depth camera alone (intrinsics, distortion, size) as a PinholeCamera, for its
+// projection and undistortion; the other fields keep their defaults.
+inline PinholeCamera depthCameraLens(const DepthCamera& d) {
+  PinholeCamera lens;
+  lens.fx = d.fx;
+  lens.fy = d.fy;
+  lens.cx = d.cx;
+  lens.cy = d.cy;
+  lens.k1 = d.k1;
+  lens.k2 = d.k2;
+  lens.p1 = d.p1;
+  lens.p2 = d.p2;
+  lens.k3 = d.k3;
+  lens.width = d.width;
+  lens.height = d.height;
+  return lens;
 }
 
 }  // namespace plumb

@@ -1,5 +1,5 @@
 #pragma once
-// FrameCapture: the first step of a run (pipeline/run/odometry_runner.h) as a sensor sees it.
+// FrameCapture: the first step of a run (pipeline/run/odometry_run.h) as a sensor sees it.
 // drivers/common/source_capture.h implements it over any FrameSource; the runner only sees this, so
 // drivers/ and pipeline/ meet here, in the contract, and neither knows the other.
 //
@@ -10,6 +10,7 @@
 #include <cstdint>
 
 #include "platform/status.h"
+#include "sensor/camera.h"
 #include "sensor/rgbd_image.h"
 
 namespace plumb {
@@ -17,6 +18,8 @@ namespace plumb {
 class FrameCapture {
  public:
   virtual ~FrameCapture() = default;
+  // The camera the frames come from (the run builds its system for it).
+  virtual const PinholeCamera& camera() const = 0;
   // Prepares the next frame (idempotent until take()/drop()) and reports its recorded time in
   // nanoseconds; false when the input has ended.
   virtual bool prepareNext(int64_t* t_recorded_ns) = 0;

@@ -63,6 +63,7 @@
 #include <Eigen/Core>
 
 #include "solver/outlier_thresholds.h"
+#include "solver/point_space_blocks.h"
 #include "solver/camera_intrinsics.h"
 #include "solver/robust_kernel.h"
 #include "solver/types.h"
@@ -165,6 +166,11 @@ class LocalBundleAdjuster {
   double observationChi2(int observation) const { return observations_[observation].chi2; }
   bool isOutlier(int observation) const { return observations_[observation].outlier; }
   double cost(const LocalBaOptions& options) const;  // robust cost at the current estimate
+  // A posteriori variance factor sigma0^2 (solver/variance_factor.h) of the inliers after solve():
+  // redundancy = inlier error dof - 6 per optimised pose - per landmark min(its inlier error dof,
+  // 3 for a point, 2 for a line sample: its slide along the line is unobservable).
+  // Read it before computeCovariance(), which re-evaluates the chi2 values. local_ba_variance.cpp.
+  double varianceFactor(const LocalBaOptions& options) const;
 
   // Diagnostics (tests): linearise at the current estimate and solve ONE damped step with the
   // given lambda, without applying it. Returns false if the damped S is not positive definite.
@@ -179,6 +185,7 @@ class LocalBundleAdjuster {
     Matrix6d H_pose = Matrix6d::Zero();  // undamped diagonal block of H_pp
     Vector6d g_pose = Vector6d::Zero();
     Vector6d step = Vector6d::Zero();
+    PoseNormalAccumulator normal;  // H_pose / g_pose as they are summed (free keyframes)
     int variable = -1;  // index into the reduced system; -1 when fixed
   };
   struct Landmark {

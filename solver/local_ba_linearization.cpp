@@ -10,6 +10,8 @@
 #include "solver/dense_cholesky.h"
 #include "solver/factors.h"
 #include "solver/local_ba.h"
+#include "solver/point_space_blocks.h"
+#include "solver/schur_kernels.h"
 
 namespace plumb {
 namespace {
@@ -23,29 +25,6 @@ inline double damping(double lambda, double diagonal) {
   return lambda * std::clamp(diagonal, kMinDiagonal, kMaxDiagonal);
 }
 
-// One whitened-and-weighted observation of R rows, folded into the landmark / pose blocks.
-struct BlockSinks {
-  Eigen::Matrix3d* H_point;
-  Eigen::Vector3d* g_point;
-  Matrix6d* H_pose;  // null for a fixed keyframe
-  Vector6d* g_pose;
-  Matrix63d* W;
-};
-
-template <int R>
-void accumulate(const Eigen::Matrix<double, R, 6>& J_pose, const Eigen::Matrix<double, R, 3>& J_point,
-                const Eigen::Matrix<double, R, 1>& e, const Eigen::Matrix<double, R, R>& weighted_information,
-                const BlockSinks& out) {
-  const Eigen::Matrix<double, 3, R> Jl_t_omega = J_point.transpose() * weighted_information;
-  out.H_point->noalias() += Jl_t_omega * J_point;
-  out.g_point->noalias() += Jl_t_omega * e;
-  if (out.H_pose == nullptr) return;
-  const Eigen::Matrix<double, 6, R> Jp_t_omega = J_pose.transpose() * weighted_information;
-  out.H_pose->noalias() += Jp_t_omega * J_pose;
-  out.g_pose->noalias() += Jp_t_omega * e;
-  out.W->noalias() = Jp_t_omega * J_point;
-}
-
 // (Pseudo-)inverse of a 3x3 landmark block. Well-conditioned blocks take the Cholesky path. A
 // rank-deficient block is inverted on its range only: a line-guidance point seen on exact lines
 // can slide along its 3D line without changing any residual, so that direction is in the null
@@ -54,13 +33,32 @@ void accumulate(const Eigen::Matrix<double, R, 6>& J_pose, const Eigen::Matrix<d
 // fixed (its observations still constrain the poses through H_pp).
 bool invertLandmarkBlock(const Eigen::Matrix3d& H, double singular_threshold, Eigen::Matrix3d* H_inv) {
   if (!H.allFinite()) return false;
-  const Eigen::LLT<Eigen::Matrix3d> llt(H);
+  // Cholesky H = L L^T written out (Eigen's LLT of a 3x3 is a generic loop, ~3x the
+  // instructions; this runs once per landmark per elimination), then H^-1 = L^-T L^-1.
   const double max_diagonal = H.diagonal().maxCoeff();
-  if (llt.info() == Eigen::Success && max_diagonal > 0.0) {
-    const double min_pivot = llt.matrixLLT().diagonal().minCoeff();
-    if (min_pivot * min_pivot > 1e-8 * max_diagonal) {  // condition well below 1e8: safe
-      *H_inv = llt.solve(Eigen::Matrix3d::Identity());
-      return true;
+  const double d0 = H(0, 0);
+  if (d0 > 0.0 && max_diagonal > 0.0) {
+    const double l00 = std::sqrt(d0);
+    const double l10 = H(1, 0) / l00, l20 = H(2, 0) / l00;
+    const double d1 = H(1, 1) - l10 * l10;
+    if (d1 > 0.0) {
+      const double l11 = std::sqrt(d1);
+      const double l21 = (H(2, 1) - l20 * l10) / l11;
+      const double d2 = H(2, 2) - l20 * l20 - l21 * l21;
+      // Smallest pivot^2 against the largest diagonal: condition well below 1e8 is safe.
+      if (d2 > 0.0 && std::min({d0, d1, d2}) > 1e-8 * max_diagonal) {
+        const double l22 = std::sqrt(d2);
+        const double i00 = 1.0 / l00, i11 = 1.0 / l11, i22 = 1.0 / l22;  // L^-1, lower triangle
+        const double i10 = -l10 * i00 * i11, i21 = -l21 * i11 * i22;
+        const double i20 = -(l20 * i00 + l21 * i10) * i22;
+        (*H_inv)(0, 0) = i00 * i00 + i10 * i10 + i20 * i20;
+        (*H_inv)(1, 0) = (*H_inv)(0, 1) = i11 * i10 + i21 * i20;
+        (*H_inv)(2, 0) = (*H_inv)(0, 2) = i22 * i20;
+        (*H_inv)(1, 1) = i11 * i11 + i21 * i21;
+        (*H_inv)(2, 1) = (*H_inv)(1, 2) = i22 * i21;
+        (*H_inv)(2, 2) = i22 * i22;
+        return true;
+      }
     }
   }
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
@@ -103,12 +101,11 @@ bool LocalBundleAdjuster::evaluateChi2(const Observation& obs, const Eigen::Isom
   return false;
 }
 
+// Per observation, in camera-point space (solver/point_space_blocks.h): the residual's 3x3
+// M = J_cam^T (w Omega) J_cam and q = J_cam^T (w Omega) e give the landmark block R^T M R, the
+// pose block A^T M A (summed per keyframe on the symmetric scalars) and W = A^T M R = [MR; [P]x MR].
 double LocalBundleAdjuster::linearize(const LocalBaOptions& options) {
-  for (int v = 0; v < num_pose_variables_; ++v) {
-    Keyframe& kf = keyframes_[variable_keyframe_[v]];
-    kf.H_pose.setZero();
-    kf.g_pose.setZero();
-  }
+  for (int v = 0; v < num_pose_variables_; ++v) keyframes_[variable_keyframe_[v]].normal = PoseNormalAccumulator();
   double cost = 0.0;
   for (int j = 0; j < num_landmarks_; ++j) {
     Landmark& lm = landmarks_[j];
@@ -118,53 +115,64 @@ double LocalBundleAdjuster::linearize(const LocalBaOptions& options) {
       Observation& obs = observations_[observation_order_[lm.first_observation + n]];
       obs.valid = false;
       if (!obs.enabled) continue;
+      obs.outlier = true;  // until it is linearised
       Keyframe& kf = keyframes_[obs.keyframe];
-      const bool free_pose = kf.variable >= 0;
-      const BlockSinks sinks{&lm.H_point, &lm.g_point, free_pose ? &kf.H_pose : nullptr, &kf.g_pose, &obs.W};
+      const Eigen::Vector3d P_cam = kf.T_cam_world * lm.P_world;
+      if (!(P_cam.z() > kFactorMinDepth)) continue;  // behind the camera: an outlier this time
       const RobustKernel kernel = options.kernelFor(obs.kind);
+      Eigen::Matrix3d M;
+      Eigen::Vector3d q;
+      RobustKernelValue k;
       switch (obs.kind) {
         case ObservationKind::kStereoPoint: {
           Eigen::Vector3d e;
-          Matrix36d J_pose;
-          Eigen::Matrix3d J_point;
-          if (!evaluateStereoPoint(camera_, kf.T_cam_world, lm.P_world, obs.z, &e, &J_pose, &J_point)) break;
-          obs.chi2 = e.dot(obs.information * e);
-          const RobustKernelValue k = evaluateKernel(kernel, obs.chi2);
-          accumulate<3>(J_pose, J_point, e, k.rho1 * obs.information, sinks);
-          cost += 0.5 * k.rho;
-          obs.valid = true;
+          Eigen::Matrix3d J_cam;
+          stereoResidualAt(camera_, P_cam, obs.z, &e, &J_cam);
+          const Eigen::Vector3d omega_e = obs.information * e;
+          obs.chi2 = e.dot(omega_e);
+          k = evaluateKernel(kernel, obs.chi2);
+          stereoPointSpaceBlocks(J_cam, obs.information, omega_e, k.rho1, &M, &q);
           break;
         }
         case ObservationKind::kMonoPoint: {
           Eigen::Vector2d e;
-          Matrix26d J_pose;
-          Matrix23d J_point;
-          if (!evaluateMonoPoint(camera_, kf.T_cam_world, lm.P_world, obs.z.head<2>(), &e, &J_pose, &J_point))
-            break;
+          Matrix23d J_cam;
+          monoResidualAt(camera_, P_cam, obs.z.head<2>(), &e, &J_cam);
           const Eigen::Matrix2d omega = obs.information.topLeftCorner<2, 2>();
           obs.chi2 = e.dot(omega * e);
-          const RobustKernelValue k = evaluateKernel(kernel, obs.chi2);
-          accumulate<2>(J_pose, J_point, e, k.rho1 * omega, sinks);
-          cost += 0.5 * k.rho;
-          obs.valid = true;
+          k = evaluateKernel(kernel, obs.chi2);
+          pointSpaceBlocks<2>(J_cam, k.rho1 * omega, e, &M, &q);
           break;
         }
-        case ObservationKind::kLineSample: {
-          Eigen::Matrix<double, 1, 1> e;
-          RowVector6d J_pose;
-          Eigen::RowVector3d J_point;
-          if (!evaluateLineSample(camera_, kf.T_cam_world, lm.P_world, obs.z, &e(0), &J_pose, &J_point)) break;
-          obs.chi2 = e(0) * e(0) * obs.information(0, 0);
-          const RobustKernelValue k = evaluateKernel(kernel, obs.chi2);
-          const Eigen::Matrix<double, 1, 1> weighted_information(k.rho1 * obs.information(0, 0));
-          accumulate<1>(J_pose, J_point, e, weighted_information, sinks);
-          cost += 0.5 * k.rho;
-          obs.valid = true;
+        case ObservationKind::kLineSample:
+        default: {  // (the enum has no other value; keeps M and q visibly assigned)
+          double e = 0.0;
+          Eigen::RowVector3d J_cam;
+          lineResidualAt(camera_, P_cam, obs.z, &e, &J_cam);
+          obs.chi2 = e * e * obs.information(0, 0);
+          k = evaluateKernel(kernel, obs.chi2);
+          const Eigen::Vector3d wj = (k.rho1 * obs.information(0, 0)) * J_cam.transpose();
+          M.noalias() = wj * J_cam;  // rank one
+          q = e * wj;
           break;
         }
       }
-      obs.outlier = !obs.valid;
+      cost += 0.5 * k.rho;
+      obs.valid = true;
+      obs.outlier = false;
+      const Eigen::Matrix3d R = kf.T_cam_world.linear();
+      const Eigen::Matrix3d MR = M * R;
+      lm.H_point.noalias() += R.transpose() * MR;
+      lm.g_point.noalias() += R.transpose() * q;
+      if (kf.variable < 0) continue;  // a fixed keyframe: residuals, no pose variable
+      kf.normal.add(M, q, P_cam);
+      obs.W.topRows<3>() = MR;
+      for (int c = 0; c < 3; ++c) obs.W.block<3, 1>(3, c) = P_cam.cross(MR.col(c));
     }
+  }
+  for (int v = 0; v < num_pose_variables_; ++v) {
+    Keyframe& kf = keyframes_[variable_keyframe_[v]];
+    kf.normal.finish(&kf.H_pose, &kf.g_pose);
   }
   return cost;
 }
@@ -202,26 +210,27 @@ bool LocalBundleAdjuster::solveDamped(const LocalBaOptions& options, double lamb
       Observation& obs = observations_[order[a]];
       const int v = keyframes_[obs.keyframe].variable;
       if (!obs.valid || v < 0) continue;
-      obs.V.noalias() = obs.W * lm.H_point_inv;
-      rhs.segment<6>(6 * v).noalias() += obs.V * lm.g_point;
+      formVAndRhs(obs.W, lm.H_point_inv, lm.g_point, &obs.V, rhs.data() + 6 * v);
       free_obs[num_free++] = order[a];
     }
     // S_ab -= V_a W_b^T for every unordered pair sharing this landmark, written into the lower
     // block triangle (row block >= column block), which is all the Cholesky reads.
+    const Eigen::Index stride = S.outerStride();
+    auto block = [&S](int row_variable, int col_variable) { return &S(6 * row_variable, 6 * col_variable); };
     for (int a = 0; a < num_free; ++a) {
       const Observation& obs_a = observations_[free_obs[a]];
       const int v_a = keyframes_[obs_a.keyframe].variable;
-      S.block<6, 6>(6 * v_a, 6 * v_a).noalias() -= obs_a.V * obs_a.W.transpose();
+      subtractVWtLower(obs_a.V, obs_a.W, block(v_a, v_a), stride);
       for (int b = a + 1; b < num_free; ++b) {
         const Observation& obs_b = observations_[free_obs[b]];
         const int v_b = keyframes_[obs_b.keyframe].variable;
         if (v_b > v_a) {
-          S.block<6, 6>(6 * v_b, 6 * v_a).noalias() -= obs_b.V * obs_a.W.transpose();
+          subtractVWt(obs_b.V, obs_a.W, block(v_b, v_a), stride);
         } else if (v_b < v_a) {
-          S.block<6, 6>(6 * v_a, 6 * v_b).noalias() -= obs_a.V * obs_b.W.transpose();
+          subtractVWt(obs_a.V, obs_b.W, block(v_a, v_b), stride);
         } else {  // two observations in one keyframe: both cross terms land on its diagonal block
-          S.block<6, 6>(6 * v_a, 6 * v_a).noalias() -= obs_a.V * obs_b.W.transpose();
-          S.block<6, 6>(6 * v_a, 6 * v_a).noalias() -= obs_b.V * obs_a.W.transpose();
+          subtractVWt(obs_a.V, obs_b.W, block(v_a, v_a), stride);
+          subtractVWt(obs_b.V, obs_a.W, block(v_a, v_a), stride);
         }
       }
     }

@@ -6,6 +6,7 @@
 #include "solver/dense_cholesky.h"
 #include "solver/local_ba.h"
 #include "solver/se3.h"
+#include "solver/trust_region.h"
 
 namespace plumb {
 
@@ -63,13 +64,12 @@ LocalBaSummary LocalBundleAdjuster::solve(const LocalBaOptions& options) {
   double cost = linearize(options);
   summary.initial_cost = cost;
   summary.status = LocalBaStatus::kMaxIterations;
-  double radius = options.initial_trust_radius;
-  double decrease_factor = 2.0;
+  TrustRegion region(options.initial_trust_radius, options.max_trust_radius);
   bool relinearize = false;
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
     if (relinearize) cost = linearize(options);
     relinearize = false;
-    const double lambda = 1.0 / radius;
+    const double lambda = region.lambda();
     ++summary.iterations;
     bool step_ok = solveDamped(options, lambda);
     bool all_valid = false;
@@ -85,13 +85,11 @@ LocalBaSummary LocalBundleAdjuster::solve(const LocalBaOptions& options) {
       predicted = modelCostReduction(lambda);
     }
     const double actual = cost - new_cost;
-    const double step_quality = predicted > 0.0 ? actual / predicted : -1.0;
+    const double step_quality = TrustRegion::stepQuality(actual, predicted);
     if (step_ok && all_valid && std::isfinite(new_cost) && step_quality > options.min_relative_decrease) {
       for (int i = 0; i < num_keyframes_; ++i) keyframes_[i].T_cam_world = keyframes_[i].T_candidate;
       for (int j = 0; j < num_landmarks_; ++j) landmarks_[j].P_world = landmarks_[j].P_candidate;
-      const double grow = 1.0 - std::pow(2.0 * step_quality - 1.0, 3);
-      radius = std::min(options.max_trust_radius, radius / std::max(1.0 / 3.0, grow));
-      decrease_factor = 2.0;
+      region.stepAccepted(step_quality);
       ++summary.successful_steps;
       relinearize = true;
       const double relative_change = actual / std::max(cost, 1e-300);
@@ -101,8 +99,7 @@ LocalBaSummary LocalBundleAdjuster::solve(const LocalBaOptions& options) {
         break;
       }
     } else {
-      radius /= decrease_factor;
-      decrease_factor *= 2.0;
+      region.stepRejected();
     }
   }
   summary.final_cost = cost;

@@ -5,6 +5,7 @@
 
 #include "solver/pose_graph.h"
 #include "solver/se3.h"
+#include "solver/trust_region.h"
 
 namespace plumb {
 namespace {
@@ -118,8 +119,7 @@ PoseGraphSummary PoseGraph::optimize(const PoseGraphOptions& options) {
   }
   summary.status = PoseGraphStatus::kMaxIterations;
   double cost = linearize();
-  double radius = options.initial_trust_radius;
-  double decrease_factor = 2.0;
+  TrustRegion region(options.initial_trust_radius, options.max_trust_radius);
   bool relinearize = false;
   bool last_solve_failed = false;
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
@@ -129,7 +129,7 @@ PoseGraphSummary PoseGraph::optimize(const PoseGraphOptions& options) {
       summary.status = PoseGraphStatus::kConverged;
       break;
     }
-    const double lambda = 1.0 / radius;
+    const double lambda = region.lambda();
     ++summary.iterations;
     const bool step_ok = solveDamped(lambda);
     last_solve_failed = !step_ok;
@@ -146,16 +146,14 @@ PoseGraphSummary PoseGraph::optimize(const PoseGraphOptions& options) {
       predicted = modelCostReduction(lambda);
     }
     const double actual = cost - new_cost;
-    const double step_quality = predicted > 0.0 ? actual / predicted : -1.0;
+    const double step_quality = TrustRegion::stepQuality(actual, predicted);
     // At the minimum the actual change is rounding noise and steps get rejected forever; the
     // model's own prediction (or a negligible step) says so first, accepted or not.
     const bool nothing_left = step_ok && (predicted <= options.function_tolerance * cost ||
                                           dx_.cwiseAbs().maxCoeff() < options.step_tolerance);
     if (step_ok && std::isfinite(new_cost) && step_quality > options.min_relative_decrease) {
       for (int n = 0; n < num_nodes_; ++n) nodes_[n].T_cam_world = nodes_[n].T_candidate;
-      const double grow = 1.0 - std::pow(2.0 * step_quality - 1.0, 3);
-      radius = std::min(options.max_trust_radius, radius / std::max(1.0 / 3.0, grow));
-      decrease_factor = 2.0;
+      region.stepAccepted(step_quality);
       ++summary.successful_steps;
       relinearize = true;
       const double relative_change = actual / std::max(cost, 1e-300);
@@ -169,8 +167,7 @@ PoseGraphSummary PoseGraph::optimize(const PoseGraphOptions& options) {
         summary.status = PoseGraphStatus::kConverged;
         break;
       }
-      radius /= decrease_factor;
-      decrease_factor *= 2.0;
+      region.stepRejected();
     }
   }
   if (summary.status == PoseGraphStatus::kMaxIterations && last_solve_failed) {

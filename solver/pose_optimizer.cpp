@@ -4,6 +4,7 @@
 #include <Eigen/SVD>
 
 #include "solver/factors.h"
+#include "solver/point_space_blocks.h"
 #include "solver/se3.h"
 
 namespace plumb {
@@ -62,66 +63,6 @@ double robustCost(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_cam
   return cost;
 }
 
-// Accumulates the pose normal equations from observations given in camera-point space. With
-// A = d P_cam / d delta = [I | -[P]x] and, per observation, M = J_cam^T (w Omega) J_cam (3x3,
-// symmetric) and q = J_cam^T (w Omega) e:
-//   H += A^T M A = [ M  N ; N^T  [P]x N ],  N = M (-[P]x),      g += A^T q = [ q ; P x q ].
-// Working with the 3x3 M instead of an R x 6 pose Jacobian, and with scalars on the symmetric
-// halves, roughly halves the flops per observation: that is the pose-only budget (< 1 ms for
-// ~1,750 observations).
-class PoseNormalAccumulator {
- public:
-  void add(const Eigen::Matrix3d& M, const Eigen::Vector3d& q, const Eigen::Vector3d& P) {
-    const double x = P.x(), y = P.y(), z = P.z();
-    const double m00 = M(0, 0), m01 = M(0, 1), m02 = M(0, 2), m11 = M(1, 1), m12 = M(1, 2), m22 = M(2, 2);
-    // N = M (-[P]x); the columns of -[P]x are (0, -z, y), (z, 0, -x), (-y, x, 0).
-    const double n00 = y * m02 - z * m01, n01 = z * m00 - x * m02, n02 = x * m01 - y * m00;
-    const double n10 = y * m12 - z * m11, n11 = z * m01 - x * m12, n12 = x * m11 - y * m01;
-    const double n20 = y * m22 - z * m12, n21 = z * m02 - x * m22, n22 = x * m12 - y * m02;
-    tt_[0] += m00, tt_[1] += m01, tt_[2] += m02, tt_[3] += m11, tt_[4] += m12, tt_[5] += m22;
-    tr_[0] += n00, tr_[1] += n01, tr_[2] += n02;
-    tr_[3] += n10, tr_[4] += n11, tr_[5] += n12;
-    tr_[6] += n20, tr_[7] += n21, tr_[8] += n22;
-    // [P]x N, upper triangle: row 0 = y N_2. - z N_1., row 1 = z N_0. - x N_2., row 2 = x N_1. - y N_0.
-    rr_[0] += y * n20 - z * n10, rr_[1] += y * n21 - z * n11, rr_[2] += y * n22 - z * n12;
-    rr_[3] += z * n01 - x * n21, rr_[4] += z * n02 - x * n22;
-    rr_[5] += x * n12 - y * n02;
-    g_[0] += q.x(), g_[1] += q.y(), g_[2] += q.z();
-    g_[3] += y * q.z() - z * q.y(), g_[4] += z * q.x() - x * q.z(), g_[5] += x * q.y() - y * q.x();
-  }
-  void finish(Matrix6d* H, Vector6d* g) const {
-    *H << tt_[0], tt_[1], tt_[2], tr_[0], tr_[1], tr_[2],  //
-        tt_[1], tt_[3], tt_[4], tr_[3], tr_[4], tr_[5],    //
-        tt_[2], tt_[4], tt_[5], tr_[6], tr_[7], tr_[8],    //
-        tr_[0], tr_[3], tr_[6], rr_[0], rr_[1], rr_[2],    //
-        tr_[1], tr_[4], tr_[7], rr_[1], rr_[3], rr_[4],    //
-        tr_[2], tr_[5], tr_[8], rr_[2], rr_[4], rr_[5];
-    *g = Eigen::Map<const Vector6d>(g_);
-  }
-
- private:
-  double tt_[6] = {};  // upper triangle of the translation block
-  double tr_[9] = {};  // translation-rotation block, row-major
-  double rr_[6] = {};  // upper triangle of the rotation block
-  double g_[6] = {};
-};
-
-// J^T W J and J^T W e in point space, by columns: GCC at -O2 does not inline Eigen's small
-// product kernels, and this runs once per observation and iteration.
-template <int R>
-inline void pointSpaceBlocks(const Eigen::Matrix<double, R, 3>& J_cam, const Eigen::Matrix<double, R, R>& W,
-                             const Eigen::Matrix<double, R, 1>& e, Eigen::Matrix3d* M, Eigen::Vector3d* q) {
-  Eigen::Matrix<double, R, 3> WJ;
-  for (int j = 0; j < 3; ++j) {
-    WJ.col(j) = W.col(0) * J_cam(0, j);
-    for (int r = 1; r < R; ++r) WJ.col(j) += W.col(r) * J_cam(r, j);
-  }
-  for (int j = 0; j < 3; ++j) {
-    for (int i = 0; i < 3; ++i) (*M)(i, j) = J_cam.col(i).dot(WJ.col(j));
-    (*q)(j) = WJ.col(j).dot(e);
-  }
-}
-
 // IRLS normal equations of the inliers at T_cam_world.
 NormalEquations linearize(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_cam_world,
                           const PosePointObservation* points, int num_points, const PoseLineObservation* lines,
@@ -140,9 +81,10 @@ NormalEquations linearize(const CameraIntrinsics& camera, const Eigen::Isometry3
       Eigen::Vector3d e;
       Eigen::Matrix3d J_cam;
       stereoResidualAt(camera, P_cam, obs.z, &e, &J_cam);
+      const Eigen::Vector3d omega_e = obs.information * e;
       double rho = 0.0, weight = 0.0;
-      robustCostAndWeight(kernels.stereo, e.dot(obs.information * e), &rho, &weight);
-      pointSpaceBlocks<3>(J_cam, weight * obs.information, e, &M, &q);
+      robustCostAndWeight(kernels.stereo, e.dot(omega_e), &rho, &weight);
+      stereoPointSpaceBlocks(J_cam, obs.information, omega_e, weight, &M, &q);
       ne.cost += 0.5 * rho;
     } else {
       Eigen::Vector2d e;
@@ -182,6 +124,7 @@ int classify(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_cam_worl
               PoseResult* result) {
   result->num_point_inliers = 0;
   result->num_line_inliers = 0;
+  result->inlier_chi2 = InlierChi2Sums{};
   int changed = 0;
   double chi2 = 0.0;
   for (int i = 0; i < num_points; ++i) {
@@ -190,12 +133,14 @@ int classify(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_cam_worl
     changed += inlier != point_inliers[i] ? 1 : 0;
     point_inliers[i] = inlier;
     result->num_point_inliers += inlier ? 1 : 0;
+    if (inlier) result->inlier_chi2.add(points[i].has_depth ? 3 : 2, chi2);
   }
   for (int i = 0; i < num_lines; ++i) {
     const bool inlier = lineChi2(camera, T_cam_world, lines[i], &chi2) && chi2 <= options.chi2.line;
     changed += inlier != line_inliers[i] ? 1 : 0;
     line_inliers[i] = inlier;
     result->num_line_inliers += inlier ? 1 : 0;
+    if (inlier) result->inlier_chi2.add(1, chi2);
   }
   return changed;
 }

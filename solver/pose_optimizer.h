@@ -23,6 +23,7 @@
 #include "solver/camera_intrinsics.h"
 #include "solver/robust_kernel.h"
 #include "solver/types.h"
+#include "solver/variance_factor.h"
 
 namespace plumb {
 
@@ -71,6 +72,9 @@ struct PoseResult {
   double final_cost = 0.0;    // robust cost of the final inliers at the final pose
   Matrix6d covariance = Matrix6d::Zero();
   bool covariance_valid = false;
+  // chi2 of the final inliers at the final pose (the last classification), for the a posteriori
+  // variance factor (solver/variance_factor.h; redundancy: their error dof - 6).
+  InlierChi2Sums inlier_chi2;
 };
 
 // Inlier flags: point_inliers[i] / line_inliers[i] are written for every observation (arrays of

@@ -24,13 +24,17 @@ void printHelp() {
       "  --pixel-noise S      Gaussian colour noise, grey levels (default 0)\n"
       "  --depth-noise        Kinect-like depth noise, sigma = k z^2\n"
       "  --depth-noise-k K    k in 1/m (default 0.0014)\n"
-      "  --holes              no depth on the far side of depth edges\n");
+      "  --holes              no depth on the far side of depth edges\n"
+      "  --depth-camera offset|offset-qvga\n"
+      "                       depth from a depth camera beside the colour camera, NOT registered to\n"
+      "                       it (2.5 cm baseline, 0.5 deg, other intrinsics; offset-qvga: 320x240);\n"
+      "                       camera.txt describes it, so plumb registers the depth (docs/SYNTHETIC.md)\n");
 }
 
 int runSynth(int argc, char** argv) {
   const plumb::tools::Args args(argc, argv,
                                 {"out", "preset", "seed", "frames", "fps", "loop-period", "pixel-noise",
-                                 "depth-noise-k"},
+                                 "depth-noise-k", "depth-camera"},
                                 {"depth-noise", "holes"});
   if (args.help()) {
     printHelp();
@@ -78,6 +82,14 @@ int runSynth(int argc, char** argv) {
     return 2;
   }
   options.seed = static_cast<uint64_t>(seed);
+  if (args.has("depth-camera")) {
+    const std::string which = args.get("depth-camera");
+    if (which != "offset" && which != "offset-qvga") {
+      std::fprintf(stderr, "plumb synth: --depth-camera takes offset or offset-qvga, not '%s'\n", which.c_str());
+      return 2;
+    }
+    options.depth_camera = which == "offset" ? plumb::synthOffsetDepthCamera() : plumb::synthOffsetDepthCameraQvga();
+  }
 
   // A dataset is never written over another: an existing folder must be empty.
   const std::string out_dir = args.get("out");

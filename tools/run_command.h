@@ -21,6 +21,7 @@
 #include "platform/status.h"
 #include "tools/flags.h"
 #include "tools/run_outputs.h"
+#include "tools/serve_flag.h"
 
 namespace plumb::tools {
 
@@ -40,9 +41,11 @@ struct RunCommandOptions {
   bool discard_trajectory = false;  // --discard-trajectory
   std::string out_optimized;        // --out-optimized FILE
   std::string covariance;           // --covariance FILE
+  std::string track_covariance;     // --track-covariance FILE
   std::string stats;                // --stats FILE
   std::string save_map;             // --save-map FILE
   std::string mavlink;              // --mavlink ENDPOINT
+  std::string serve;                // --serve PORT|HOST:PORT (docs/VIEWER.md)
   // odometry
   long long line_samples = 5;   // --line-samples N
   bool no_lines = false;        // --no-lines
@@ -83,6 +86,7 @@ struct RunPlan {
   loop::SavedMap loaded_map;
   double map_read_ms = 0;
   loop::SavedMap saved_map;  // filled by the run when --save-map
+  RunServe serve;            // --serve: the viewer, serving from the end of the plan on
 };
 
 // plan: a usage problem (combination of flags, an output that is an input) sets *usage_error; any

@@ -6,8 +6,9 @@
 namespace plumb::tools {
 
 void executeRun(const RunCommandOptions& options, RunPlan& plan, RunOutputs& outputs, RunExecution* execution) {
-  execution->status =
-      runToOutputs(*plan.source, plan.system_options, plan.run_options, outputs, &execution->record);
+  execution->status = runToOutputs(*plan.source, plan.system_options, plan.run_options, outputs,
+                                   &execution->record, plan.serve.wrap(outputs));
+  plan.serve.stop();
   if (options.save_map.empty()) return;
   // The map is written whatever ended the run (a stop, a read error): like the trajectory, it holds
   // what was computed. But only a map plumb can load again: one without a keyframe (the run never

@@ -11,6 +11,7 @@
 
 #include "drivers/common/source_capture.h"
 #include "pipeline/odometry/odometry_trajectory.h"
+#include "pipeline/odometry/published_covariance.h"
 
 namespace plumb::tools {
 
@@ -28,6 +29,7 @@ struct StreamedFrame {
   uint32_t reference_id = 0;
   double T_ref_cam[12] = {};    // 3x4, row major
   double T_world_cam[12] = {};  // real-time pose (fallback)
+  uint64_t loop_epoch = 0;      // FinishedFrame::loop_epoch
 };
 
 void toRows(const Eigen::Isometry3d& T, double* out) {
@@ -50,17 +52,21 @@ RunOutputs::~RunOutputs() {
   if (frames_stream_ != nullptr) std::fclose(frames_stream_);
 }
 
-Status RunOutputs::open() {
+Status RunOutputs::begin(const OdometrySystem&) {
   if (!options_.optimized_path.empty()) {
     frames_stream_ = std::tmpfile();
     if (frames_stream_ == nullptr) return Status::Error("--out-optimized: cannot create a temporary file");
   }
   if (!options_.trajectory_path.empty()) PLUMB_RETURN_IF_ERROR(trajectory_writer_.open(options_.trajectory_path));
   if (!options_.covariance_path.empty()) PLUMB_RETURN_IF_ERROR(covariance_writer_.open(options_.covariance_path));
+  if (!options_.track_covariance_path.empty()) {
+    PLUMB_RETURN_IF_ERROR(track_covariance_writer_.open(options_.track_covariance_path, CovarianceFileKind::kTracked));
+  }
   if (!options_.mavlink.endpoint.empty()) {
     mavlink_ = std::make_unique<MavlinkOdometrySink>();
     PLUMB_RETURN_IF_ERROR(mavlink_->open(options_.mavlink).withContext("--mavlink"));
   }
+  opened_ = true;
   return Status::Ok();
 }
 
@@ -75,22 +81,28 @@ void RunOutputs::onPose(const FrameOutput& out) {
   sample.tracking_quality = out.state == TrackingState::kOk ? 100 : out.state == TrackingState::kWeak ? 50 : 0;
   sample.has_covariance = out.has_pose && out.track.covariance_valid;
   sample.covariance = out.track.covariance;
-  // The estimate jumps at a new map segment and at a relocalization: the autopilot must know.
-  sample.reset = out.new_map || out.relocalized;
+  sample.has_local_covariance = out.has_pose && out.track.covariance_local_valid;
+  sample.local_covariance = out.track.covariance_local;
+  // The estimate jumps at a new map segment, a relocalization and a loop correction: the
+  // autopilot must know (docs/LOOP.md "What the robot receives").
+  sample.reset = out.new_map || out.relocalized || out.loop_corrected;
   mavlink_->publish(sample);
 }
 
 Status RunOutputs::close(bool keep) {
   endProgress();
+  if (!opened_) return Status::Ok();
   if (!keep) {
     trajectory_writer_.abandon();
     covariance_writer_.abandon();
+    track_covariance_writer_.abandon();
     if (frames_stream_ != nullptr) std::fclose(frames_stream_);
     frames_stream_ = nullptr;
     return Status::Ok();
   }
   if (!options_.trajectory_path.empty()) PLUMB_RETURN_IF_ERROR(trajectory_writer_.close());
   if (!options_.covariance_path.empty()) PLUMB_RETURN_IF_ERROR(covariance_writer_.close());
+  if (!options_.track_covariance_path.empty()) PLUMB_RETURN_IF_ERROR(track_covariance_writer_.close());
   return Status::Ok();
 }
 
@@ -153,6 +165,9 @@ Status RunOutputs::onFrame(const FrameOutput& out) {
   }
   keyframes_ += out.keyframe;
   lost_ += !out.has_pose;
+  if (!options_.track_covariance_path.empty() && out.has_pose) {
+    PLUMB_RETURN_IF_ERROR(track_covariance_writer_.append(toStampedTrackedCovariance(out)));
+  }
   const uint64_t frame = statistics_.frames();
   if (options_.trace) {
     const Eigen::Vector3d t = out.T_world_cam.translation();
@@ -177,6 +192,7 @@ Status RunOutputs::onFinishedFrame(const FinishedFrame& f) {
     r.reference_id = f.reference_id;
     toRows(f.T_ref_cam, r.T_ref_cam);
     toRows(f.T_world_cam, r.T_world_cam);
+    r.loop_epoch = f.loop_epoch;
     if (std::fwrite(&r, sizeof(r), 1, frames_stream_) != 1) return Status::Error("--out-optimized: temporary file write failed");
   }
   if (!options_.trajectory_path.empty()) return trajectory_writer_.append(pose);
@@ -198,14 +214,13 @@ Status RunOutputs::writeOptimized(const LoopRunResult& loop) {
     pose.valid = r.valid != 0;
     pose.dropped = r.dropped != 0;
     pose.T_world_cam = fromRows(r.T_world_cam);
-    Eigen::Isometry3d T_world_ref;
-    if (pose.valid) {
-      if (r.reference_id != 0 && loop.keyframePose(r.reference_id, &T_world_ref)) {
-        pose.T_world_cam = T_world_ref * fromRows(r.T_ref_cam);
-      } else {
-        ++optimized_without_keyframe_;
-      }
-    }
+    FinishedFrame frame;
+    frame.valid = pose.valid;
+    frame.reference_id = r.reference_id;
+    frame.T_ref_cam = fromRows(r.T_ref_cam);
+    frame.T_world_cam = pose.T_world_cam;
+    frame.loop_epoch = r.loop_epoch;
+    if (pose.valid && !loop.optimisedPose(frame, &pose.T_world_cam)) ++optimized_without_keyframe_;
     if (options_.keep_trajectory) optimized_.push_back(pose);
     PLUMB_RETURN_IF_ERROR(writer.append(pose));
   }
@@ -216,29 +231,22 @@ Status RunOutputs::writeOptimized(const LoopRunResult& loop) {
 
 Status RunOutputs::onRetiredKeyframe(const RetiredKeyframe& kf) {
   if (options_.covariance_path.empty()) return Status::Ok();
-  StampedCovariance c;
-  c.timestamp = kf.timestamp_s;
-  c.valid = kf.covariance_valid;
-  c.covariance = kf.covariance;
-  return covariance_writer_.append(c);
+  return covariance_writer_.append(toStampedCovariance(kf));
 }
 
 Status runToOutputs(FrameSource& source, const SystemOptions& system_options, const OdometryRunOptions& run_options,
-                    RunOutputs& outputs, RunRecord* record) {
-  std::unique_ptr<OdometrySystem> system;
-  PLUMB_RETURN_IF_ERROR(OdometrySystem::create(source.camera(), system_options, &system));
-  PLUMB_RETURN_IF_ERROR(outputs.open());
+                    RunOutputs& outputs, RunRecord* record, OdometrySink* sink) {
   SourceCapture capture(source, run_options.stop);
-  const Status status = runOdometry(capture, *system, outputs, run_options, &record->run);
+  const Status status = runOdometry(capture, system_options, sink != nullptr ? *sink : outputs, run_options, &record->run);
   // The outputs hold what was computed whatever ended the run, but a run that produced no frame
   // (it failed or was stopped before its first one) replaces no file: an older trajectory of that
   // name is worth more than an empty one.
   record->outputs_kept = record->run.frames + record->run.frames_dropped > 0;
   record->outputs_status = outputs.close(record->outputs_kept);
   if (record->outputs_kept && record->outputs_status.ok()) record->outputs_status = outputs.writeOptimized(record->run.loop);
-  record->odometry = system->stats();
-  record->mapper = system->mapperStats();
-  record->mapper_waits = system->mapperWaits();
+  record->odometry = record->run.odometry;
+  record->mapper = record->run.mapper;
+  record->mapper_waits = record->run.mapper_waits;
   return status.ok() ? record->outputs_status : status;
 }
 

@@ -20,6 +20,7 @@ namespace plumb::tools {
 struct RunOutputOptions {
   std::string trajectory_path;  // TUM file, one line per input frame ('' = none)
   std::string covariance_path;  // one line per keyframe ('' = none)
+  std::string track_covariance_path;  // one line per tracked frame ('' = none)
   // The optimised trajectory (docs/LOOP.md): every frame through its reference keyframe's pose in
   // the final pose graph, written at the end of the run ('' = none).
   std::string optimized_path;
@@ -46,11 +47,17 @@ class RunOutputs final : public OdometrySink {
   explicit RunOutputs(const RunOutputOptions& options);
   ~RunOutputs() override;
   static constexpr std::size_t kMaxReservedPoses = 108'000;  // an hour at 30 Hz
-  Status open();   // the files
+  // Opens the files; called by the run session once the run has been checked (a refused run
+  // opens none).
+  Status begin(const OdometrySystem&) override;
   // Flushes and closes them, under their names (keep) or not at all (abandon: the run produced
   // nothing valid, e.g. it failed before its first frame; an older file of that name stays).
+  // Nothing when they were never opened.
   Status close(bool keep = true);
-  bool anyFile() const { return !options_.trajectory_path.empty() || !options_.covariance_path.empty() || !options_.optimized_path.empty(); }
+  bool anyFile() const {
+    return !options_.trajectory_path.empty() || !options_.covariance_path.empty() ||
+           !options_.track_covariance_path.empty() || !options_.optimized_path.empty();
+  }
   void endProgress();  // ends the terminal's progress line
 
   void onPose(const FrameOutput& frame) override;
@@ -74,8 +81,10 @@ class RunOutputs final : public OdometrySink {
   void progressLine(uint64_t frame, const FrameOutput& out);
 
   RunOutputOptions options_;
+  bool opened_ = false;
   TumTrajectoryWriter trajectory_writer_;
   CovarianceWriter covariance_writer_;
+  CovarianceWriter track_covariance_writer_;
   std::vector<StampedPose> trajectory_;
   // --out-optimized: one fixed-size record per finished frame in an anonymous temporary file
   // (std::tmpfile: removed by the OS however the process ends), so memory stays flat.
@@ -106,10 +115,13 @@ struct RunRecord {
   Status outputs_status;
 };
 
-// Builds the system, runs it over `source` through the one runner into `outputs` (opened first,
-// closed after, also when the run failed: what was computed is kept; a run that produced no frame
-// replaces no file). The options were validated by the caller's plan (tools/run_plan.cpp).
+// Runs `source` through runOdometry() (pipeline/run/odometry_run.h: system, session, runner) into
+// `outputs` (opened when the run has been checked, closed after, also when the run failed: what
+// was computed is kept; a run that produced no frame replaces no file). The options were validated
+// by the caller's plan (tools/run_plan.cpp).
+// `sink`: what the run calls when not `outputs` itself, i.e. a decorator that forwards to
+// `outputs` (the viewer's, viewer/viewer_sink.h); nullptr: `outputs`.
 Status runToOutputs(FrameSource& source, const SystemOptions& system_options, const OdometryRunOptions& run_options,
-                    RunOutputs& outputs, RunRecord* record);
+                    RunOutputs& outputs, RunRecord* record, OdometrySink* sink = nullptr);
 
 }  // namespace plumb::tools

@@ -34,7 +34,11 @@ FlagTable runFlagTable(RunCommandOptions* o) {
       .toggle("no-loops", &o->no_loops, "no loop closing (--out-optimized then equals --out)")
       .text("covariance", "FILE", &o->covariance,
             "per keyframe: timestamp and the 21 upper-triangle entries of its 6x6\n"
-            "pose covariance from local BA (docs/ODOMETRY.md)")
+            "pose covariance from local BA, then its pose relative to the previous\n"
+            "keyframe with that covariance (docs/DATA_FORMATS.md)")
+      .text("track-covariance", "FILE", &o->track_covariance,
+            "per tracked frame: the pose and its covariances as MAVLink sends them\n"
+            "(docs/UNCERTAINTY.md)")
       .text("stats", "FILE", &o->stats,
             "statistics as JSON (states, keyframes, map, ms per frame, RSS, every option)")
       .integer("max-frames", "N", 1, kMaxFrameCount, &o->max_frames, "stop after N frames")
@@ -66,6 +70,10 @@ FlagTable runFlagTable(RunCommandOptions* o) {
       .text("mavlink", "ENDPOINT", &o->mavlink,
             "MAVLink v2 ODOMETRY + HEARTBEAT to an autopilot, as each pose is tracked:\n"
             "udp:HOST:PORT or serial:DEVICE:BAUD (frames: docs/MAVLINK.md)")
+      .text("serve", "PORT|HOST:PORT", &o->serve,
+            "watch live: Foxglove WebSocket server + page at http://HOST:PORT/ (PORT\n"
+            "alone: this machine only; HOST:PORT binds HOST: anyone who reaches it can\n"
+            "watch; docs/VIEWER.md). Read-only: the outputs are the same without it")
       .section("schedule (capture -> extract -> track -> map, docs/RUNTIME.md):")
       .text("mode", "M", &o->mode,
             "deterministic (default: the stages in lock-step on one thread, the\n"

@@ -1,7 +1,7 @@
 // `plumb run`, step 2 of 4 (tools/run_command.h): every check that needs no frame, in one place,
 // before any work. Ranges were checked by the parser; here: combinations of flags, the options of
 // the system and of the runner (validated once, here), outputs against inputs, the MAVLink
-// endpoint, the ground truth, the map, and the source.
+// endpoint, the ground truth, the map, and the source; last the viewer (--serve) binds its address.
 #include <unistd.h>
 
 #include <algorithm>
@@ -33,7 +33,7 @@ Status checkCombinations(const RunCommandOptions& o) {
     MavlinkEndpoint endpoint;
     PLUMB_RETURN_IF_ERROR(parseMavlinkEndpoint(o.mavlink, &endpoint).withContext("--mavlink"));
   }
-  return Status::Ok();
+  return checkServeSpec(o.serve);
 }
 
 // The system's and the runner's options from the root, validated (the one place tools/ does it).
@@ -67,6 +67,7 @@ Status checkFiles(const RunCommandOptions& o) {
   io.addOutput("--save-map", o.save_map);
   io.addOutput("--out", o.out);
   io.addOutput("--covariance", o.covariance);
+  io.addOutput("--track-covariance", o.track_covariance);
   io.addOutput("--out-optimized", o.out_optimized);
   io.addOutput("--stats", o.stats);
   io.addOutput("--profile", o.profile);
@@ -120,6 +121,7 @@ Status planRun(const RunCommandOptions& o, const std::atomic<bool>* stop, RunPla
   RunOutputOptions& out = plan->output_options;
   out.trajectory_path = o.out;
   out.covariance_path = o.covariance;
+  out.track_covariance_path = o.track_covariance;
   out.optimized_path = o.out_optimized;
   out.rss_every = long(o.rss_every);
   out.report_every = long(o.report_every);
@@ -135,7 +137,9 @@ Status planRun(const RunCommandOptions& o, const std::atomic<bool>* stop, RunPla
   if (o.max_frames > 0 && (expected == 0 || std::size_t(o.max_frames) < expected)) expected = std::size_t(o.max_frames);
   out.expected_frames = expected;
   out.mavlink.endpoint = o.mavlink;
-  return Status::Ok();
+  // Last, once everything else is known to be usable: the viewer binds its address (one in use
+  // fails here, before any frame) and serves from now on.
+  return plan->serve.start(o.serve, o.mode, o.dataset);
 }
 
 }  // namespace plumb::tools

@@ -17,7 +17,7 @@
 //   }
 //   odometry->finish();                    // then popFinished() the held-back rest
 //
-// track() runs the same stage objects as `plumb run` (pipeline/run/odometry_stepper.h), lock-step,
+// track() steps the same run session as `plumb run` (pipeline/run/run_session.h), lock-step,
 // one frame per call: the same frames give the same poses as `plumb run --mode deterministic`.
 // After a warm-up of ~30 frames a call allocates no memory.
 //

@@ -12,6 +12,12 @@ with callgrind_annotate. Whole-run counts divided by the number of frames:
   track          OdometrySystem::trackFeatures (Tracker::track; relocalisation when lost)
   map            OdometrySystem::mapFrame      (keyframe insertion; counted over all frames)
   map.local_ba   LocalMapper::runLocalBa       (BA set-up, LM solve, covariances)
+  loop           LoopStage::process            (loop closing per keyframe: place recognition,
+                                                verification, pose graph; its own thread in the
+                                                threaded modes, inline in deterministic mode)
+
+and `total`, the sum of extract + track + map (a frame's work on the tracking path; the loop
+stage is printed beside it, since it runs once per keyframe, off that path).
 
 Scene set-up, image decoding/rendering and file output are not in any stage. Callgrind counts
 the instructions the (simulated) CPU executes; OpenCV's runtime dispatch picks SIMD paths from
@@ -40,7 +46,9 @@ STAGES = [
     ("track", "plumb::OdometrySystem::trackFeatures("),
     ("map", "plumb::OdometrySystem::mapFrame("),
     ("map.local_ba", "plumb::LocalMapper::runLocalBa("),
+    ("loop", "plumb::LoopStage::process("),
 ]
+TOTAL = ("extract", "track", "map")
 
 # "1,234,567 (12.34%)  file:function [object]"; the file part holds no colon ("???" without -g).
 LINE = re.compile(r"^\s*([\d,]+)\s+\(\s*[\d.]+%\)\s+[^:\s]*:(.+?)(?:\s+\[[^\]]*\])?\s*$")
@@ -85,7 +93,7 @@ def read_budgets(path):
             if len(parts) != 2 or not parts[1].isdigit():
                 sys.exit(f"{path}:{number}: expected 'stage instructions_per_frame', got {line!r}")
             budgets[parts[0]] = int(parts[1])
-    unknown = set(budgets) - {s for s, _ in STAGES}
+    unknown = set(budgets) - {s for s, _ in STAGES} - {"total"}
     if unknown:
         sys.exit(f"{path}: unknown stages {sorted(unknown)}")
     return budgets
@@ -136,6 +144,8 @@ def main():
     for stage, prefix in STAGES:
         per_frame[stage] = totals.get(stage, 0) // frames
         print(f"  {stage:<14} {per_frame[stage]:>14,}   {prefix[:-1]}")
+    per_frame["total"] = sum(per_frame[stage] for stage in TOTAL)
+    print(f"  {'total':<14} {per_frame['total']:>14,}   {' + '.join(TOTAL)}")
     if not args.check:
         return 0
 

@@ -6,8 +6,8 @@
 //   3. --mode fast: frames per second over (1)  (target >= 1.6 on 2 cores); (1) and (3) are run
 //      --repeat times (default 3), alternating, and the best run of each is compared: on a shared
 //      machine other jobs only ever slow a run down;
-//      Fast mode's trajectory must be byte-identical to (1) too (the tracker never runs past a
-//      keyframe it asked for and the loop stage is in lock-step with the map: docs/RUNTIME.md);
+//      Fast mode's trajectory must be byte-identical to (1) too (map updates reach tracking at the
+//      same fixed lag and the loop stage is in lock-step with the map: docs/RUNTIME.md);
 //   4. --mode realtime at the recorded rate: p99 end-to-end latency (target <= 33 ms), drops (0);
 //      with --rt-priority P its stage threads run SCHED_FIFO at P (the map stage stays normal,
 //      niced), as firmware would on a shared CPU (falls back with a warning when not permitted).
@@ -109,8 +109,6 @@ Status runMode(const std::string& dir, long frames, runtime::RunMode mode, const
                Trajectory* out, OdometryRunResult* result, int realtime_priority = 0, bool loop_closing = true) {
   std::unique_ptr<FrameSource> source;
   PLUMB_RETURN_IF_ERROR(open(dir, &source));
-  std::unique_ptr<OdometrySystem> system;
-  PLUMB_RETURN_IF_ERROR(OdometrySystem::create(source->camera(), SystemOptions{}, &system));
   OdometryRunOptions options;
   options.schedule.mode = mode;
   options.schedule.realtime_priority = realtime_priority;
@@ -124,7 +122,7 @@ Status runMode(const std::string& dir, long frames, runtime::RunMode mode, const
   if (fifo_here) (void)applyThreadSettings(ThreadSettings{"", -1, realtime_priority});
   const double cpu_start = processCpuSeconds();
   const int64_t start = monotonicNowNs();
-  const Status status = runOdometry(capture, *system, sink, options, result);
+  const Status status = runOdometry(capture, SystemOptions{}, sink, options, result);
   out->seconds = static_cast<double>(monotonicNowNs() - start) * 1e-9;
   out->cpu_seconds = processCpuSeconds() - cpu_start;
   if (fifo_here) normalScheduling();

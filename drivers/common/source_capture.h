@@ -22,6 +22,8 @@ class SourceCapture final : public FrameCapture {
   }
   ~SourceCapture() override { source_.setStopFlag(nullptr); }
 
+  const PinholeCamera& camera() const override { return source_.camera(); }
+
   bool prepareNext(int64_t* t_recorded_ns) override;
   Status take(RgbdImage& out) override;
   bool drop(uint64_t* sequence, double* timestamp_s) override;

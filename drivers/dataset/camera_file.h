@@ -5,6 +5,11 @@
 //   width height           image size in pixels (optional, default 640 480)
 //   depth_factor           raw depth units per metre (optional, default 5000)
 //   baseline               virtual stereo baseline in metres (optional, default 0.08)
+//   rolling_shutter_readout  seconds from first to last row (optional, default 0)
+//   depth_fx depth_fy depth_cx depth_cy depth_k1..depth_k3 depth_width depth_height
+//   depth_to_colour_qx qy qz qw tx ty tz
+//                          optional: depth from a separate depth camera, not registered to colour
+//                          (all but the distortion required once one is given; sensor/depth_camera.h)
 // Unknown keys, repeated keys, unparsable or non-finite values are errors naming file and line.
 // Format documented in docs/DATA_FORMATS.md.
 #include <string>

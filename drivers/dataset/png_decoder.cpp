@@ -75,6 +75,23 @@ struct PngCallbacks {
   }
 };
 
+std::size_t pngFileBound(int width, int height, int bytes_per_pixel) {
+  const std::size_t filtered = std::size_t(height) * (std::size_t(width) * std::size_t(bytes_per_pixel) + 1);
+  return filtered + filtered / 1000 + (std::size_t(64) << 10);
+}
+
+void PngDecoder::reserve(int width, int height) {
+#ifdef PLUMB_HAVE_LIBDEFLATE
+  if (fast_ && width > 0 && height > 0) {
+    fast_->reserve(pngFileBound(width, height, 3), std::size_t(height) * (std::size_t(width) * 3 + 1),
+                   std::size_t(width) * 3);
+  }
+#else
+  (void)width;
+  (void)height;
+#endif
+}
+
 PngDecoder::PngDecoder() : arena_(kArenaBytes) {
   rows_.reserve(1024);
 #ifdef PLUMB_HAVE_LIBDEFLATE

@@ -36,6 +36,12 @@ struct PngHeader {
   int channels = 0;   // after the transforms: 1..4
 };
 
+// An upper bound on the file size of a PNG of width x height with bytes_per_pixel (3: BGR 8-bit,
+// 2: 16-bit depth): the filtered scanlines, deflate's worst case for incompressible data (stored
+// blocks, ~0.01 % overhead), chunk headers and ancillary chunks (64 KiB). Readers size their
+// buffers with it once, so decoding a stream of such images allocates nothing.
+std::size_t pngFileBound(int width, int height, int bytes_per_pixel);
+
 class PngDecoder {
  public:
   PngDecoder();
@@ -48,6 +54,10 @@ class PngDecoder {
   // Decodes the image whose header readHeader() just read into dst, which is (re)allocated only
   // when its size or type differ. Call right after a successful readHeader() on the same bytes.
   bool decodePixels(cv::Mat& dst);
+  // Sizes the scratch for images up to width x height with up to 3 bytes a pixel (BGR 8-bit, or
+  // 16-bit depth), so that decoding them allocates nothing (larger files still decode: the
+  // scratch then grows, with headroom).
+  void reserve(int width, int height);
   // What went wrong, e.g. "corrupt or truncated PNG (IDAT: CRC error)". Valid until the next call.
   const char* error() const { return error_; }
   // malloc calls libpng made beyond the arena since construction (0 for ordinary PNGs).

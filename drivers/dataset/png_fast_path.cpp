@@ -17,6 +17,12 @@ void PngFastPath::Scratch::ensure(std::size_t needed) {
   bytes.reset(new uint8_t[size]);  // default-initialised: untouched pages stay out of RSS
 }
 
+void PngFastPath::reserve(std::size_t file_bytes, std::size_t filtered_bytes, std::size_t row_bytes) {
+  compressed_.ensure(file_bytes);
+  filtered_.ensure(filtered_bytes);
+  if (zero_row_.size() < row_bytes) zero_row_.assign(row_bytes, 0);
+}
+
 namespace {
 
 uint32_t bigEndian32(const uint8_t* p) {

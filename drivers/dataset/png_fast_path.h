@@ -20,6 +20,9 @@ class PngFastPath {
   PngFastPath(const PngFastPath&) = delete;
   PngFastPath& operator=(const PngFastPath&) = delete;
 
+  // Scratch for files up to file_bytes whose scanlines (filter bytes included) need up to
+  // filtered_bytes, rows up to row_bytes: allocated now instead of at the first such file.
+  void reserve(std::size_t file_bytes, std::size_t filtered_bytes, std::size_t row_bytes);
   // Whether this layout is handled here (IHDR values as stored).
   static bool handles(int bit_depth, int colour_type, int interlace);
   // Decodes the whole file into dst (already created with the right size and type: BGR order,

@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -37,9 +38,13 @@ std::string imageProblem(int type, int width, int height, bool is_depth, const P
   const int expected_type = is_depth ? CV_16UC1 : CV_8UC3;
   if (type != expected_type)
     return typeName(type) + " image, expected " + (is_depth ? "16-bit 1-channel depth" : "8-bit 3-channel colour");
-  if (width != camera.width || height != camera.height)
-    return "size " + std::to_string(width) + "x" + std::to_string(height) + ", camera expects " +
-           std::to_string(camera.width) + "x" + std::to_string(camera.height);
+  // Depth from an unregistered depth camera has that camera's size (registered later, in the pipeline).
+  const int expected_width = is_depth ? camera.depthWidth() : camera.width;
+  const int expected_height = is_depth ? camera.depthHeight() : camera.height;
+  if (width != expected_width || height != expected_height)
+    return "size " + std::to_string(width) + "x" + std::to_string(height) + ", " +
+           (is_depth && !camera.depthRegistered() ? "depth camera" : "camera") + " expects " +
+           std::to_string(expected_width) + "x" + std::to_string(expected_height);
   return "";
 }
 
@@ -55,9 +60,10 @@ int64_t monotonicNowNs() {
 
 // Reads the whole file into `bytes` (grown only when a file is larger than any before: no
 // allocation per frame; POSIX read, because stdio's FILE allocates its buffer on every fopen).
-Status readFileBytes(const std::string& path, std::unique_ptr<unsigned char[]>* bytes, std::size_t* capacity,
-                     std::size_t* size) {
-  InputFile file;
+// `file` is the caller's, reused frame after frame: its path string keeps its capacity, so opening
+// the next image allocates nothing (a fresh opener per image cost two allocations a frame).
+Status readFileBytes(const std::string& path, InputFile& file, std::unique_ptr<unsigned char[]>* bytes,
+                     std::size_t* capacity, std::size_t* size) {
   PLUMB_RETURN_IF_ERROR(file.open(path, kMaxImageFileBytes, "image file"));
   const int fd = file.fd();
   const auto expected = static_cast<std::size_t>(file.size());
@@ -129,13 +135,19 @@ Status TumDatasetSource::open(const std::string& dir, const PinholeCamera& camer
     source->depth_files_.push_back(dir + "/" + frame.depth_path);
   }
   source->png_ = std::make_unique<PngDecoder>();
+  // Buffers for the largest image file the camera's images can be (colour, or depth at the depth
+  // camera's size), once: replaying then allocates nothing per frame, whatever the file sizes.
+  const int width = std::max(camera.width, camera.depthWidth()), height = std::max(camera.height, camera.depthHeight());
+  source->png_->reserve(width, height);
+  source->file_capacity_ = pngFileBound(width, height, 3);
+  source->file_bytes_.reset(new unsigned char[source->file_capacity_]);  // not zero-filled: address space only
   *out = std::move(source);
   return Status::Ok();
 }
 
 Status TumDatasetSource::loadImage(const std::string& path, bool is_depth, cv::Mat& dst) {
   std::size_t size = 0;
-  PLUMB_RETURN_IF_ERROR(readFileBytes(path, &file_bytes_, &file_capacity_, &size));
+  PLUMB_RETURN_IF_ERROR(readFileBytes(path, image_file_, &file_bytes_, &file_capacity_, &size));
   PngHeader header;
   if (png_->readHeader(file_bytes_.get(), size, &header)) {
     // PNG (every TUM and ICL-NUIM image): libpng straight into dst, checked before decoding.

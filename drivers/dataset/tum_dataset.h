@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "drivers/common/frame_source.h"
+#include "platform/input_file.h"
 
 namespace plumb {
 
@@ -75,6 +76,7 @@ class TumDatasetSource : public FrameSource {
   // headroom costs address space, not resident memory).
   std::unique_ptr<unsigned char[]> file_bytes_;
   std::size_t file_capacity_ = 0;
+  InputFile image_file_;  // the opener of each image file, reused (no allocation per frame)
   std::unique_ptr<PngDecoder> png_;
 };
 

@@ -93,7 +93,8 @@ void MavlinkOdometrySink::buildOdometry(const OdometrySample& sample, MavlinkOdo
   // Linear and angular velocity of the body, in the body frame (child_frame_id BODY_FRD), from
   // the previous published pose. Unknown (NaN) on the first pose and after a reset or a gap.
   const double dt = sample.timestamp_s - previous_time_s_;
-  if (has_previous_ && dt > 1e-6) {
+  const bool have_velocity = has_previous_ && dt > 1e-6;
+  if (have_velocity) {
     const Eigen::Matrix3d& R = T_local_body.linear();
     const Eigen::Vector3d v_body = R.transpose() * (p - previous_T_local_body_.translation()) / dt;
     const Eigen::Vector3d w_body = logSO3(previous_T_local_body_.linear().transpose() * R) / dt;
@@ -117,9 +118,18 @@ void MavlinkOdometrySink::buildOdometry(const OdometrySample& sample, MavlinkOdo
     const Matrix6d covariance = mavlinkPoseCovariance(sample.covariance, sample.T_world_cam, frames_);
     if (covariance.allFinite()) upperTriangle21(covariance, m.pose_covariance);
   }
-  // plumb has no velocity covariance (consecutive poses' correlation is not kept): unknown.
+  // Velocity covariance from the two poses' covariances relative to the map (odometry_frames.h).
   std::fill(std::begin(m.velocity_covariance), std::end(m.velocity_covariance), 0.f);
   m.velocity_covariance[0] = kNaN;
+  if (have_velocity && previous_has_local_covariance_ && sample.has_local_covariance) {
+    const Matrix6d covariance =
+        mavlinkVelocityCovariance(previous_local_covariance_, sample.local_covariance, previous_T_world_cam_,
+                                  sample.T_world_cam, dt, frames_);
+    if (covariance.allFinite()) upperTriangle21(covariance, m.velocity_covariance);
+  }
+  previous_T_world_cam_ = sample.T_world_cam;
+  previous_has_local_covariance_ = sample.has_local_covariance;
+  previous_local_covariance_ = sample.local_covariance;
 
   m.frame_id = options_.frame_id;
   m.child_frame_id = kMavFrameBodyFrd;

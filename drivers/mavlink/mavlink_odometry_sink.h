@@ -58,6 +58,10 @@ struct OdometrySample {
   int tracking_quality = 0;  // 0 (unknown) .. 100 (best), from the tracking state
   bool has_covariance = false;
   Matrix6d covariance = Matrix6d::Zero();  // of delta = [rho; phi] of T_cam_world (solver/se3.h)
+  // The pose's covariance relative to the map (TrackResult::covariance_local): the velocity
+  // covariance is built from this one of two consecutive samples.
+  bool has_local_covariance = false;
+  Matrix6d local_covariance = Matrix6d::Zero();
   bool reset = false;  // the estimate jumped (new map segment, loop correction): reset_counter++
 };
 
@@ -106,6 +110,9 @@ class MavlinkOdometrySink {
   bool has_previous_ = false;
   double previous_time_s_ = 0.0;
   Eigen::Isometry3d previous_T_local_body_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d previous_T_world_cam_ = Eigen::Isometry3d::Identity();
+  bool previous_has_local_covariance_ = false;
+  Matrix6d previous_local_covariance_ = Matrix6d::Zero();
   uint8_t payload_[kMavlinkMaxPayloadBytes] = {};
   uint8_t frame_[kMavlinkV2MaxFrameBytes] = {};
 };

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "solver/pose_covariance.h"
 #include "solver/se3.h"
+#include "solver/se3_jacobians.h"
 
 namespace plumb {
 
@@ -57,6 +59,23 @@ Matrix6d mavlinkPoseCovariance(const Matrix6d& covariance_delta, const Eigen::Is
                                const MavlinkFrameChange& frames) {
   const Matrix6d J = mavlinkPoseJacobian(T_world_cam, frames);
   return J * covariance_delta * J.transpose();
+}
+
+Matrix6d mavlinkVelocityCovariance(const Matrix6d& local_covariance_previous, const Matrix6d& local_covariance,
+                                   const Eigen::Isometry3d& T_world_cam_previous, const Eigen::Isometry3d& T_world_cam,
+                                   double dt_s, const MavlinkFrameChange& frames) {
+  const Eigen::Isometry3d T_cam_world_previous = T_world_cam_previous.inverse();
+  const Eigen::Isometry3d T_cam_world = T_world_cam.inverse();
+  const Matrix6d relative = relativePoseCovariance(T_cam_world_previous, T_cam_world, local_covariance_previous,
+                                                   local_covariance, Matrix6d::Zero());
+  // The body's motion over the interval, in the body frame at the end (what v is expressed in).
+  const Eigen::Isometry3d T_body_previous_body =
+      frames.T_body_cam * T_cam_world_previous * T_world_cam * frames.T_body_cam.inverse();
+  const Eigen::Vector3d motion_in_body = T_body_previous_body.linear().transpose() * T_body_previous_body.translation();
+  Matrix6d J = Matrix6d::Identity();
+  J.topRightCorner<3, 3>() = hat(motion_in_body);
+  J = (J * adjointSE3(frames.T_body_cam)) / dt_s;
+  return J * relative * J.transpose();
 }
 
 void upperTriangle21(const Matrix6d& m, float out[21]) {

@@ -53,6 +53,18 @@ Matrix6d mavlinkPoseJacobian(const Eigen::Isometry3d& T_world_cam, const Mavlink
 Matrix6d mavlinkPoseCovariance(const Matrix6d& covariance_delta, const Eigen::Isometry3d& T_world_cam,
                                const MavlinkFrameChange& frames);
 
+// Covariance of the velocity MAVLink sends, [vx vy vz rollspeed pitchspeed yawspeed] in the body
+// frame (docs/MAVLINK.md "Velocity covariance"), from the two poses it is differenced from and
+// their covariances RELATIVE TO THE MAP (TrackResult::covariance_local; a map error common to both
+// cancels in their difference), taken as independent:
+//   e = Ad(T_cam_k_world T_cam_{k-1}_world^-1) d_{k-1} - d_k   (the relative camera motion's
+//       right perturbation, Cov(e) = A L_{k-1} A^T + L_k; solver/pose_covariance.h)
+//   eps = Ad(T_body_cam) e                                     (the same motion of the body)
+//   d[v; w] = (1/dt) [I  [v dt]x; 0  I] eps                    (first order; per-frame rotation small)
+Matrix6d mavlinkVelocityCovariance(const Matrix6d& local_covariance_previous, const Matrix6d& local_covariance,
+                                   const Eigen::Isometry3d& T_world_cam_previous, const Eigen::Isometry3d& T_world_cam,
+                                   double dt_s, const MavlinkFrameChange& frames);
+
 // Row-major upper-right triangle (21 values: row 0 has 6, row 1 has 5, ...), as float.
 void upperTriangle21(const Matrix6d& m, float out[21]);
 

@@ -111,7 +111,9 @@ class OpenNI2Source : public FrameSource {
                                        options_.height, options_.fps, openni::PIXEL_FORMAT_RGB888,
                                        "colour", &mode));
       if (colour_.setVideoMode(mode) != openni::STATUS_OK) return openniError("colour video mode");
-      if (options_.register_depth_to_colour &&
+      // A camera file that describes the depth camera asks for plumb's own registration (the
+      // pipeline's register stage): the device must then deliver depth as its depth camera sees it.
+      if (options_.register_depth_to_colour && !softwareRegistration() &&
           device_.isImageRegistrationModeSupported(openni::IMAGE_REGISTRATION_DEPTH_TO_COLOR) &&
           device_.setImageRegistrationMode(openni::IMAGE_REGISTRATION_DEPTH_TO_COLOR) !=
               openni::STATUS_OK)
@@ -130,12 +132,14 @@ class OpenNI2Source : public FrameSource {
     return Status::Ok();
   }
 
+  bool softwareRegistration() const { return has_fallback_ && fallback_.depth_camera.has_value(); }
+
   Status chooseCamera() {
     const openni::VideoMode mode = colour_.getVideoMode();
     const double hfov = colour_.getHorizontalFieldOfView();
     const double vfov = colour_.getVerticalFieldOfView();
     const bool device_reports = std::isfinite(hfov) && std::isfinite(vfov) && hfov > 0 && vfov > 0;
-    if (has_fallback_ && (options_.prefer_fallback_camera || !device_reports)) {
+    if (has_fallback_ && (options_.prefer_fallback_camera || !device_reports || softwareRegistration())) {
       camera_ = fallback_;
       camera_source_ = "camera file";
     } else if (device_reports) {

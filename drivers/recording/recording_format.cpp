@@ -11,35 +11,49 @@ namespace plumb {
 
 void encodeFileHeader(const PinholeCamera& camera, std::vector<uint8_t>& out) {
   const std::size_t start = out.size();
+  const bool depth_camera = camera.depth_camera.has_value();
   ByteWriter w(out);
   w.bytes(kRecordingMagic, sizeof kRecordingMagic);
-  w.u32(kRecordingVersion);
-  w.u32(static_cast<uint32_t>(kFileHeaderSize));
+  w.u32(depth_camera ? kRecordingVersionDepthCamera : kRecordingVersion);
+  w.u32(static_cast<uint32_t>(depth_camera ? kFileHeaderSizeDepthCamera : kFileHeaderSize));
   for (double v : {camera.fx, camera.fy, camera.cx, camera.cy, camera.k1, camera.k2, camera.p1,
                    camera.p2, camera.k3, camera.depth_factor, camera.baseline_m, camera.rolling_shutter_readout_s}) {
     w.f64(v);
   }
   w.i32(camera.width);
   w.i32(camera.height);
+  if (depth_camera) {
+    const DepthCamera& d = *camera.depth_camera;
+    for (double v : {d.fx, d.fy, d.cx, d.cy, d.k1, d.k2, d.p1, d.p2, d.k3}) w.f64(v);
+    w.i32(d.width);
+    w.i32(d.height);
+    for (double v : {d.qx, d.qy, d.qz, d.qw, d.tx, d.ty, d.tz}) w.f64(v);
+  }
   w.u32(crc32(out.data() + start, out.size() - start));
 }
 
-Status decodeFileHeader(const uint8_t* bytes, std::size_t size, PinholeCamera* camera) {
+Status decodeFileHeader(const uint8_t* bytes, std::size_t size, PinholeCamera* camera, std::size_t* header_size_out) {
   if (size < kFileHeaderSize)
     return Status::Error("file header truncated (" + std::to_string(size) + " of " +
                          std::to_string(kFileHeaderSize) + " bytes)");
   if (std::memcmp(bytes, kRecordingMagic, sizeof kRecordingMagic) != 0)
     return Status::Error("not a plumb recording (magic is not PLUMBREC)");
-  ByteReader r(bytes + 8, kFileHeaderSize - 8);
+  ByteReader r(bytes + 8, size - 8);
   const uint32_t version = r.u32();
   const uint32_t header_size = r.u32();
-  if (version != kRecordingVersion)
-    return Status::Error("unsupported recording version " + std::to_string(version) +
-                         " (this build reads version " + std::to_string(kRecordingVersion) + ")");
-  if (header_size != kFileHeaderSize)
+  if (version != kRecordingVersion && version != kRecordingVersionDepthCamera)
+    return Status::Error("unsupported recording version " + std::to_string(version) + " (this build reads versions " +
+                         std::to_string(kRecordingVersion) + " and " + std::to_string(kRecordingVersionDepthCamera) +
+                         ")");
+  const bool depth_camera = version == kRecordingVersionDepthCamera;
+  const std::size_t expected_size = depth_camera ? kFileHeaderSizeDepthCamera : kFileHeaderSize;
+  if (header_size != expected_size)
     return Status::Error("file header size " + std::to_string(header_size) + " is not " +
-                         std::to_string(kFileHeaderSize));
-  const uint32_t expected_crc = crc32(bytes, kFileHeaderSize - 4);
+                         std::to_string(expected_size));
+  if (size < expected_size)
+    return Status::Error("file header truncated (" + std::to_string(size) + " of " + std::to_string(expected_size) +
+                         " bytes)");
+  const uint32_t expected_crc = crc32(bytes, expected_size - 4);
   PinholeCamera c;
   for (double* v : {&c.fx, &c.fy, &c.cx, &c.cy, &c.k1, &c.k2, &c.p1, &c.p2, &c.k3,
                     &c.depth_factor, &c.baseline_m, &c.rolling_shutter_readout_s}) {
@@ -47,12 +61,21 @@ Status decodeFileHeader(const uint8_t* bytes, std::size_t size, PinholeCamera* c
   }
   c.width = r.i32();
   c.height = r.i32();
+  if (depth_camera) {
+    DepthCamera d;
+    for (double* v : {&d.fx, &d.fy, &d.cx, &d.cy, &d.k1, &d.k2, &d.p1, &d.p2, &d.k3}) *v = r.f64();
+    d.width = r.i32();
+    d.height = r.i32();
+    for (double* v : {&d.qx, &d.qy, &d.qz, &d.qw, &d.tx, &d.ty, &d.tz}) *v = r.f64();
+    c.depth_camera = d;
+  }
   if (r.u32() != expected_crc) return Status::Error("file header CRC mismatch (header damaged)");
   if (c.width > kMaxImageSide || c.height > kMaxImageSide)
     return Status::Error("file header: image size out of range");
   const std::string problem = c.validate();
   if (!problem.empty()) return Status::Error("file header: camera invalid: " + problem);
   *camera = c;
+  if (header_size_out != nullptr) *header_size_out = expected_size;
   return Status::Ok();
 }
 

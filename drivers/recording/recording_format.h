@@ -4,7 +4,8 @@
 //
 //   file   = FileHeader chunk*
 //   chunk  = ChunkHeader payload chunk_crc
-//   FileHeader (124 bytes): "PLUMBREC", version, header size, camera, header CRC
+//   FileHeader (124 bytes; 260 in version 3): "PLUMBREC", version, header size, camera, [depth
+//              camera,] header CRC
 //   ChunkHeader (16 bytes): "PLCK", type, payload size, CRC of these 12 bytes
 //   chunk_crc (4 bytes): CRC-32 of ChunkHeader + payload
 //
@@ -24,6 +25,12 @@ constexpr char kRecordingMagic[8] = {'P', 'L', 'U', 'M', 'B', 'R', 'E', 'C'};
 // Version 2 added the camera's rolling-shutter readout time (version 1 files are refused).
 constexpr uint32_t kRecordingVersion = 2;
 constexpr std::size_t kFileHeaderSize = 124;
+// Version 3: version 2's header with the unregistered depth camera (PinholeCamera::depth_camera)
+// after the camera; written only for such a camera, so every other recording stays version 2 byte
+// for byte. Its frames' depth images have the depth camera's size.
+constexpr uint32_t kRecordingVersionDepthCamera = 3;
+constexpr std::size_t kFileHeaderSizeDepthCamera = 260;
+constexpr std::size_t kMaxFileHeaderSize = kFileHeaderSizeDepthCamera;
 
 constexpr char kChunkMagic[4] = {'P', 'L', 'C', 'K'};
 constexpr std::size_t kChunkHeaderSize = 16;
@@ -65,9 +72,11 @@ struct IndexEntry {
   uint64_t chunk_offset = 0;  // byte offset of the frame chunk's "PLCK"
 };
 
-// File header <-> bytes. decode checks magic, version, size, CRC and the camera's validity.
+// File header <-> bytes (version 2, or 3 for a camera with a depth camera). decode checks magic,
+// version, size, CRC and the camera's validity, and says how long the header was.
 void encodeFileHeader(const PinholeCamera& camera, std::vector<uint8_t>& out);
-Status decodeFileHeader(const uint8_t* bytes, std::size_t size, PinholeCamera* camera);
+Status decodeFileHeader(const uint8_t* bytes, std::size_t size, PinholeCamera* camera,
+                        std::size_t* header_size = nullptr);
 
 // Chunk header fields; decode returns false unless magic and header CRC hold and the size is sane.
 struct ChunkHeader {

@@ -45,10 +45,10 @@ Status RecordingSource::open(const std::string& path, std::unique_ptr<RecordingS
   std::unique_ptr<RecordingSource> source(new RecordingSource());
   source->path_ = path;
   PLUMB_RETURN_IF_ERROR(openFile(path, &source->file_, &source->file_size_));
-  uint8_t header[kFileHeaderSize];
+  uint8_t header[kMaxFileHeaderSize];
   const std::size_t n = source->readAt(0, header, sizeof header);
-  PLUMB_RETURN_IF_ERROR(decodeFileHeader(header, n, &source->camera_).withContext(path));
-  source->pos_ = kFileHeaderSize;
+  PLUMB_RETURN_IF_ERROR(decodeFileHeader(header, n, &source->camera_, &source->header_size_).withContext(path));
+  source->pos_ = source->header_size_;
   source->scan_.resize(kScanWindow);
   *out = std::move(source);
   return Status::Ok();
@@ -59,7 +59,7 @@ RecordingSource::~RecordingSource() {
 }
 
 void RecordingSource::rewind() {
-  pos_ = kFileHeaderSize;
+  pos_ = header_size_;
   stats_ = RecordingStats();
   has_last_timestamp_ = false;
   last_error_ = Status::Ok();
@@ -80,6 +80,11 @@ Status RecordingSource::overrideCamera(const PinholeCamera& camera) {
     return Status::Error(path_ + ": camera is " + std::to_string(camera.width) + "x" +
                          std::to_string(camera.height) + " but the recording is " +
                          std::to_string(camera_.width) + "x" + std::to_string(camera_.height));
+  // Its depth images have the recording's depth size: a depth camera of another size cannot have made them.
+  if (camera.depthWidth() != camera_.depthWidth() || camera.depthHeight() != camera_.depthHeight())
+    return Status::Error(path_ + ": the camera's depth camera is " + std::to_string(camera.depthWidth()) + "x" +
+                         std::to_string(camera.depthHeight()) + " but the recording's depth images are " +
+                         std::to_string(camera_.depthWidth()) + "x" + std::to_string(camera_.depthHeight()));
   camera_ = camera;
   return Status::Ok();
 }
@@ -204,8 +209,9 @@ bool RecordingSource::decodeFrame(const FrameChunkInfo& info, const uint8_t* ima
     return false;
   if (!decodeColour(images, info.colour_size, info.colour_codec, info.width, info.height, out.bgr))
     return false;
-  if (!decodeDepth(images + info.colour_size, info.depth_size, info.depth_codec, info.width,
-                   info.height, out.depth_raw))
+  // Version 3: the depth camera's size (registered depth: the colour size).
+  if (!decodeDepth(images + info.colour_size, info.depth_size, info.depth_codec, camera_.depthWidth(),
+                   camera_.depthHeight(), out.depth_raw))
     return false;
   has_last_timestamp_ = true;
   last_timestamp_s_ = info.timestamp_s;

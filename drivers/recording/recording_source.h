@@ -57,6 +57,7 @@ class RecordingSource : public FrameSource {
   std::FILE* file_ = nullptr;
   uint64_t file_size_ = 0;
   uint64_t pos_ = 0;  // offset of the next chunk
+  std::size_t header_size_ = 0;  // the file header's size (version 2 or 3), where chunks begin
   PinholeCamera camera_;
   RecordingStats stats_;
   bool has_last_timestamp_ = false;

@@ -43,8 +43,11 @@ Status RecordingWriter::append(const RgbdImage& frame) {
       frame.bgr.rows != camera_.height)
     return Status::Error(path_ + ": colour image must be CV_8UC3 " + std::to_string(camera_.width) +
                          "x" + std::to_string(camera_.height));
-  if (frame.depth_raw.type() != CV_16UC1 || frame.depth_raw.size() != frame.bgr.size())
-    return Status::Error(path_ + ": depth image must be CV_16UC1 of the colour image's size");
+  // Unregistered depth (a version 3 file) has the depth camera's size, registered depth the colour's.
+  if (frame.depth_raw.type() != CV_16UC1 || frame.depth_raw.cols != camera_.depthWidth() ||
+      frame.depth_raw.rows != camera_.depthHeight())
+    return Status::Error(path_ + ": depth image must be CV_16UC1 " + std::to_string(camera_.depthWidth()) + "x" +
+                         std::to_string(camera_.depthHeight()));
 
   chunk_.clear();
   beginChunk(ChunkType::kFrame, chunk_);

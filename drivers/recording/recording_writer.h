@@ -38,7 +38,8 @@ class RecordingWriter {
   RecordingWriter(const RecordingWriter&) = delete;
   RecordingWriter& operator=(const RecordingWriter&) = delete;
 
-  // Frame images must match the camera size: CV_8UC3 bgr, CV_16UC1 depth_raw.
+  // Frame images must match the camera size: CV_8UC3 bgr, CV_16UC1 depth_raw (of the depth
+  // camera's size when the camera has one: the file is then version 3).
   Status append(const RgbdImage& frame);
   // Writes the last index and the end chunk, fsyncs and closes. Idempotent.
   Status close();

@@ -75,6 +75,22 @@ void FrameRenderer::populateBuffers(void* renderer) {
 }
 
 void FrameRenderer::render(const Eigen::Isometry3d& T_world_cam) {
+  rasterise(T_world_cam);
+  // Painting draws in the colour buffer (borrowed canvas, see the constructor): all of it before
+  // shading writes colours. A face's texels do not depend on when it is painted.
+  // The helper thread works only on frames that paint faces (the first frame, and first sightings
+  // later): a steady run's frames render on the caller alone, as they did before it existed, so
+  // a real-time pipeline fed by this scene keeps the other core.
+  painted_faces_ = textures_.prepareAll(won_quads_.data(), static_cast<int>(won_quads_.size()), helper_.get()) > 0;
+  shadePixels(painted_faces_);
+}
+
+void FrameRenderer::renderDepth(const Eigen::Isometry3d& T_world_cam) {
+  rasterise(T_world_cam);
+  painted_faces_ = false;
+}
+
+void FrameRenderer::rasterise(const Eigen::Isometry3d& T_world_cam) {
   transformQuads(T_world_cam);
   // Plain fill: cv::Mat::setTo allocates a scratch buffer on every call.
   float* depth = depth_m_.ptr<float>();
@@ -85,13 +101,6 @@ void FrameRenderer::render(const Eigen::Isometry3d& T_world_cam) {
   won_quads_.clear();
   for (int q = 0; q < static_cast<int>(quads_cam_.size()); ++q)
     if (quads_cam_[q].facing && rasteriseQuad(q)) won_quads_.push_back(q);
-  // Painting draws in the colour buffer (borrowed canvas, see the constructor): all of it before
-  // shading writes colours. A face's texels do not depend on when it is painted.
-  // The helper thread works only on frames that paint faces (the first frame, and first sightings
-  // later): a steady run's frames render on the caller alone, as they did before it existed, so
-  // a real-time pipeline fed by this scene keeps the other core.
-  painted_faces_ = textures_.prepareAll(won_quads_.data(), static_cast<int>(won_quads_.size()), helper_.get()) > 0;
-  shadePixels(painted_faces_);
 }
 
 void FrameRenderer::transformQuads(const Eigen::Isometry3d& T_world_cam) {

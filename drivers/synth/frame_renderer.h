@@ -39,6 +39,9 @@ class FrameRenderer {
   FrameRenderer& operator=(const FrameRenderer&) = delete;
 
   void render(const Eigen::Isometry3d& T_world_cam);
+  // The z-buffer pass alone (no painting, no shading): depth() is valid after it, colour() is
+  // not. For a second camera that sees only depth (depth_camera_view.h).
+  void renderDepth(const Eigen::Isometry3d& T_world_cam);
 
   // Results of the last render: linear colour (BGR, 0..255, may exceed 255 slightly before
   // quantisation) and depth z in metres along the optical axis (+inf where nothing was hit).
@@ -62,6 +65,8 @@ class FrameRenderer {
   // Helper-thread job started by the constructor: maps buffers_ and the painting scratch.
   static void populateBuffers(void* renderer);
   void transformQuads(const Eigen::Isometry3d& T_world_cam);
+  // Transform + rasterise every facing quad; fills won_quads_.
+  void rasterise(const Eigen::Isometry3d& T_world_cam);
   // Returns whether the quad won at least one pixel (so far: a later quad may cover it again).
   bool rasteriseQuad(int quad_index);
   void shadePixels(bool two_threads);

@@ -13,7 +13,11 @@ namespace {
 
 constexpr uint64_t kColourStream = 1, kDepthStream = 2;
 
-inline uint8_t toByte(float v) { return static_cast<uint8_t>(std::clamp(v, 0.0f, 255.0f) + 0.5f); }
+// v >= 0 after the clamp, where + 0.5 and truncation round correctly; lround would change the
+// rendered images' bytes in rare float ties.
+inline uint8_t toByte(float v) {
+  return static_cast<uint8_t>(std::clamp(v, 0.0f, 255.0f) + 0.5f);  // NOLINT(bugprone-incorrect-roundings)
+}
 
 // True when a neighbour of (x, y) is nearer than z by more than the discontinuity threshold.
 bool onFarSideOfEdge(const cv::Mat& depth_m, int x, int y, float z, bool wide) {

@@ -16,6 +16,7 @@
 // the trajectory and the determinism guarantees.
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <Eigen/Geometry>
@@ -59,7 +60,23 @@ struct SynthOptions {
   bool depth_edge_holes = false;    // zero depth on the far side of depth discontinuities (1-3 px)
   double max_depth_m = 8.0;         // farther surfaces read 0 (no reading), like the sensor
   double min_depth_m = 0.3;         // nearer surfaces read 0
+
+  // Depth from a separate depth camera, NOT registered to colour (UVC depth cameras: RealSense,
+  // Orbbec, a Kinect v1 without registration): depth images are rendered from this camera (its
+  // intrinsics and size, at T_world_colour * T_colour_depth; no distortion: the renderer is a
+  // pinhole), and the scene's camera() carries it, so plumb registers the depth before use.
+  // Colour images and ground truth stay the colour camera's, byte for byte. Empty (default):
+  // depth rendered from the colour camera (registered). synthOffsetDepthCamera() is a typical one.
+  std::optional<DepthCamera> depth_camera;
 };
+
+// A Kinect v1 / RealSense-like depth camera beside the synthetic colour camera (docs/SYNTHETIC.md
+// "Unregistered depth"): 640x480, fx = fy = 575, principal point (314, 243), 2.5 cm to the side
+// (T_colour_depth translation (0.025, 0.001, -0.002) m) and turned 0.53 degrees.
+DepthCamera synthOffsetDepthCamera();
+// The same depth camera with half the resolution (320x240, same field of view and pose): a depth
+// image smaller than the colour image, as many depth cameras deliver.
+DepthCamera synthOffsetDepthCameraQvga();
 
 // The frame count a preset is meant to be run with: 300 (10 s) for the room presets, 1200 (both
 // laps) for "loop", 900 (30 s, ~13.5 m of corridor) for "repeated"; 0 for an unknown preset.
@@ -70,8 +87,9 @@ int presetDefaultFrames(const std::string& preset);
 // Empty-OK or a message naming the bad option (unknown preset, frames <= 0, fps <= 0, ...).
 Status validate(const SynthOptions& options);
 
-// The camera of every synthetic scene: 640x480, fx = fy = 525, cx = 319.5, cy = 239.5,
-// no distortion, depth_factor 5000 (TUM Freiburg "ROS default" intrinsics).
+// The (colour) camera of every synthetic scene: 640x480, fx = fy = 525, cx = 319.5, cy = 239.5,
+// no distortion, depth_factor 5000 (TUM Freiburg "ROS default" intrinsics). A scene with
+// SynthOptions::depth_camera adds it to this camera (SyntheticScene::camera()).
 PinholeCamera synthCamera();
 
 class SyntheticSceneImpl;

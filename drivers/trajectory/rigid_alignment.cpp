@@ -1,6 +1,6 @@
 #include "drivers/trajectory/rigid_alignment.h"
 
-#include <Eigen/SVD>
+#include "solver/rigid_fit.h"
 
 namespace plumb {
 
@@ -12,36 +12,17 @@ Status alignRigid(const std::vector<Eigen::Vector3d>& p_source, const std::vecto
   const std::size_t n = p_source.size();
   if (n < 3) return Status::Error("rigid alignment: needs at least 3 point pairs, got " + std::to_string(n));
 
-  Eigen::Vector3d mean_source = Eigen::Vector3d::Zero(), mean_target = Eigen::Vector3d::Zero();
-  for (std::size_t i = 0; i < n; ++i) {
-    mean_source += p_source[i];
-    mean_target += p_target[i];
-  }
+  // A degenerate set (all at one position) has no rotation to find.
+  Eigen::Vector3d mean_source = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : p_source) mean_source += p;
   mean_source /= static_cast<double>(n);
-  mean_target /= static_cast<double>(n);
-
-  // Cross-covariance of the centred sets; its SVD gives the rotation that best maps source
-  // directions onto target directions (Umeyama 1991, eq. 38-40 without scale).
-  Eigen::Matrix3d cross_covariance = Eigen::Matrix3d::Zero();
   double source_spread = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d s = p_source[i] - mean_source;
-    cross_covariance += (p_target[i] - mean_target) * s.transpose();
-    source_spread += s.squaredNorm();
-  }
+  for (const Eigen::Vector3d& p : p_source) source_spread += (p - mean_source).squaredNorm();
   if (!(source_spread > 1e-18))
     return Status::Error("rigid alignment: degenerate points (all at one position)");
-
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(cross_covariance, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  // A reflection (det = -1) fits mirrored data better but is not a rotation: flip the axis of the
-  // smallest singular value instead.
-  Eigen::Matrix3d reflection_guard = Eigen::Matrix3d::Identity();
-  if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0) reflection_guard(2, 2) = -1;
-  const Eigen::Matrix3d R_target_source = svd.matrixU() * reflection_guard * svd.matrixV().transpose();
-
-  T_target_source->setIdentity();
-  T_target_source->linear() = R_target_source;
-  T_target_source->translation() = mean_target - R_target_source * mean_source;
+  // The tree's one least-squares rigid fit (solver/rigid_fit.h).
+  if (!rigidFitKabsch(p_source.data(), p_target.data(), nullptr, int(n), T_target_source))
+    return Status::Error("rigid alignment: no fit");
   return Status::Ok();
 }
 

@@ -2,7 +2,7 @@
 // Rigid (rotation + translation, no scale) least-squares alignment of two point sets, the
 // closed form of Horn (1987) / Umeyama (1991) that the TUM benchmark's evaluate_ate uses:
 //   T_target_source = argmin sum_i |p_target_i - T * p_source_i|^2
-// via the SVD of the 3x3 cross-covariance, with the reflection guard of Umeyama.
+// via the SVD of the 3x3 cross-covariance, with the reflection guard of Umeyama (solver/rigid_fit.h).
 #include <Eigen/Geometry>
 #include <vector>
 

@@ -42,6 +42,8 @@ Status V4l2Source::openNodes() {
     V4l2CaptureOptions d = c;
     d.device_path = options_.depth_device;
     d.format = V4l2PixelFormat::kZ16;
+    d.width = camera_.depthWidth();  // an unregistered depth camera has its own size
+    d.height = camera_.depthHeight();
     const Status st = depth_.open(d);
     if (!st.ok()) {
       colour_.close();
@@ -163,13 +165,14 @@ bool V4l2Source::convert(RgbdImage& out) {
     case V4l2PixelFormat::kY16:
       return false;
   }
+  const int dw = camera_.depthWidth(), dh = camera_.depthHeight();
   if (options_.depth_device.empty()) {
-    out.depth_raw.create(h, w, CV_16UC1);
+    out.depth_raw.create(dh, dw, CV_16UC1);
     out.depth_raw.setTo(0);
     out.depth_timestamp_s = c.timestamp_ns * 1e-9;
   } else {
-    if (depth_view_.bytes_used < depth_view_.stride * h) return false;
-    z16ToDepth(depth_view_.data, w, h, depth_view_.stride, out.depth_raw);
+    if (depth_view_.bytes_used < depth_view_.stride * dh) return false;
+    z16ToDepth(depth_view_.data, dw, dh, depth_view_.stride, out.depth_raw);
     out.depth_timestamp_s = depth_view_.timestamp_ns * 1e-9;
   }
   // Sequence: driver counter differences within a session; across a reopen, the time gap.

@@ -48,19 +48,19 @@ FeatureExtractor::FeatureExtractor(const PinholeCamera& camera, const ExtractorO
 
 FeatureExtractor::~FeatureExtractor() = default;
 
-bool FeatureExtractor::extract(const RgbdImage& in, FrameFeatures& out) {
+bool FeatureExtractor::extract(const cv::Mat& bgr, const cv::Mat& depth_raw, double depth_factor, FrameFeatures& out) {
   const auto t_start = StageClock::now();
   const double cpu_start = threadCpuMs();
   out.clear();
   timings_ = ExtractorTimings();
-  if (in.bgr.empty() || in.bgr.cols != camera_.width || in.bgr.rows != camera_.height ||
-      (in.bgr.type() != CV_8UC3 && in.bgr.type() != CV_8UC1)) {
+  if (bgr.empty() || bgr.cols != camera_.width || bgr.rows != camera_.height ||
+      (bgr.type() != CV_8UC3 && bgr.type() != CV_8UC1)) {
     return false;
   }
-  if (in.bgr.type() == CV_8UC3) {
-    cv::cvtColor(in.bgr, grey_, cv::COLOR_BGR2GRAY);
+  if (bgr.type() == CV_8UC3) {
+    cv::cvtColor(bgr, grey_, cv::COLOR_BGR2GRAY);
   } else {
-    in.bgr.copyTo(grey_);
+    bgr.copyTo(grey_);
   }
 
   const auto t_orb = StageClock::now();
@@ -79,9 +79,9 @@ bool FeatureExtractor::extract(const RgbdImage& in, FrameFeatures& out) {
 
   const auto t_depth = StageClock::now();
   const double cpu_depth = threadCpuMs();
-  const bool depth_ok = !in.depth_raw.empty() && in.depth_raw.type() == CV_16UC1 &&
-                        in.depth_raw.cols == camera_.width && in.depth_raw.rows == camera_.height;
-  depth_->attachDepth(depth_ok ? in.depth_raw : cv::Mat(), in.depth_factor, out);
+  const bool depth_ok = !depth_raw.empty() && depth_raw.type() == CV_16UC1 &&
+                        depth_raw.cols == camera_.width && depth_raw.rows == camera_.height;
+  depth_->attachDepth(depth_ok ? depth_raw : cv::Mat(), depth_factor, out);
   timings_.depth_ms = msSince(t_depth);
   timings_.depth_cpu_ms = threadCpuMs() - cpu_depth;
 

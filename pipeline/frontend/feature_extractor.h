@@ -33,7 +33,9 @@ class FeatureExtractor {
   // Fills `out` (cleared first). `in.bgr` must be CV_8UC3 (or CV_8UC1) of the camera size;
   // `in.depth_raw` CV_16UC1 of the same size, or empty (then every feature is 2D-only).
   // Returns false (and leaves `out` empty) when the image does not match the camera.
-  bool extract(const RgbdImage& in, FrameFeatures& out);
+  bool extract(const RgbdImage& in, FrameFeatures& out) { return extract(in.bgr, in.depth_raw, in.depth_factor, out); }
+  // The same with the depth given apart from the colour (registered depth: depth_registration.h).
+  bool extract(const cv::Mat& bgr, const cv::Mat& depth_raw, double depth_factor, FrameFeatures& out);
 
   const ExtractorTimings& lastTimings() const { return timings_; }
   const ExtractorOptions& options() const { return options_; }

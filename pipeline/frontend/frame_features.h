@@ -10,6 +10,9 @@
 #include <cstdint>
 
 #include <Eigen/Core>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "pipeline/frontend/capacities.h"
 #include "pipeline/frontend/matcher_grid.h"
@@ -32,9 +35,31 @@ struct Descriptor256 {
   std::array<uint64_t, 4> words{};
 };
 
+// Bits that differ. x86-64 without -mpopcnt (the portable baseline) compiles
+// __builtin_popcountll to a call into libgcc (~25 instructions a word, 7 M instructions a frame
+// in matching and loop verification on head250), so there the count is SSE2 bit-slicing: bits
+// summed in pairs, nibbles, bytes, then the bytes of each half by psadbw (~30 instructions for
+// all 256 bits). aarch64 (NEON cnt) and -mpopcnt builds keep the builtin, which is inline there.
+// tests/pipeline/frontend_kernels_test.cpp checks it against a bit-by-bit count.
 inline int hammingDistance(const Descriptor256& a, const Descriptor256& b) {
+#if defined(__SSE2__) && !defined(__POPCNT__)
+  const __m128i* pa = reinterpret_cast<const __m128i*>(a.words.data());
+  const __m128i* pb = reinterpret_cast<const __m128i*>(b.words.data());
+  const __m128i m1 = _mm_set1_epi8(0x55), m2 = _mm_set1_epi8(0x33), m4 = _mm_set1_epi8(0x0f);
+  auto byteCounts = [&](__m128i x) {
+    x = _mm_sub_epi8(x, _mm_and_si128(_mm_srli_epi64(x, 1), m1));
+    x = _mm_add_epi8(_mm_and_si128(x, m2), _mm_and_si128(_mm_srli_epi64(x, 2), m2));
+    return _mm_and_si128(_mm_add_epi8(x, _mm_srli_epi64(x, 4)), m4);
+  };
+  const __m128i lo = byteCounts(_mm_xor_si128(_mm_loadu_si128(pa), _mm_loadu_si128(pb)));
+  const __m128i hi = byteCounts(_mm_xor_si128(_mm_loadu_si128(pa + 1), _mm_loadu_si128(pb + 1)));
+  // Each byte <= 8, so the two byte vectors add without overflow; psadbw sums 8 bytes per half.
+  const __m128i sums = _mm_sad_epu8(_mm_add_epi8(lo, hi), _mm_setzero_si128());
+  return _mm_cvtsi128_si32(sums) + _mm_cvtsi128_si32(_mm_unpackhi_epi64(sums, sums));
+#else
   return __builtin_popcountll(a.words[0] ^ b.words[0]) + __builtin_popcountll(a.words[1] ^ b.words[1]) +
          __builtin_popcountll(a.words[2] ^ b.words[2]) + __builtin_popcountll(a.words[3] ^ b.words[3]);
+#endif
 }
 
 struct KeypointObservation {

@@ -51,8 +51,9 @@ void FastDetector::begin(const cv::Mat& image, int border) {
   dropped_ = 0;
   num_raw_ = 0;
   const int x_end = image.cols - border_, y_end = image.rows - border_;
+  const int row_bytes = x_end - border_ + 2;
   for (int y = border_ - 1; y <= y_end; ++y) {
-    std::memset(score_.ptr<uint8_t>(y) + border_ - 1, 0, static_cast<size_t>(x_end - border_ + 2));
+    std::memset(score_.ptr<uint8_t>(y) + border_ - 1, 0, static_cast<size_t>(row_bytes));
   }
 }
 
@@ -64,14 +65,17 @@ void FastDetector::scan(int threshold, int x0, int y0, int x1, int y1) {
   const int x_end = std::min(x1, image.cols - border_), y_end = std::min(y1, image.rows - border_);
   threshold = std::clamp(threshold, 1, 254);
 
-  int circle[16];
-  for (int k = 0; k < 16; ++k) circle[k] = kCircleY[k] * stride + kCircleX[k];
+  // Pointer-sized offsets: with int ones GCC re-extended all 16 to 64 bits at every row (about a
+  // tenth of the scan, as the low-threshold pass visits many short cell rows).
+  std::ptrdiff_t circle[16];
+  for (int k = 0; k < 16; ++k) circle[k] = std::ptrdiff_t(kCircleY[k]) * stride + kCircleX[k];
   // Unsigned byte comparisons as signed ones on values with the top bit flipped (SSE2 only has
   // signed byte compares): a > b  <=>  (a ^ 0x80) > (b ^ 0x80).
   const cv::v_uint8x16 t = cv::v_setall_u8(static_cast<uint8_t>(threshold));
   const cv::v_int8x16 sign = cv::v_setall_s8(-128);
   auto flip = [&sign](const cv::v_uint8x16& v) { return cv::v_reinterpret_as_s8(v) ^ sign; };
   const cv::v_int8x16 nine = cv::v_setall_s8(9);
+  const cv::v_uint8x16 zero = cv::v_setzero_u8();
   auto record = [&](uint8_t* score_row, int x, int y, int score) {
     if (score <= threshold) return;
     score_row[x] = static_cast<uint8_t>(std::min(score, 255));
@@ -100,14 +104,20 @@ void FastDetector::scan(int threshold, int x0, int y0, int x1, int y1) {
       const int first_lane = x - bx;
       x = bx + 16;
       const cv::v_uint8x16 c = cv::v_load(row + bx);
-      const cv::v_int8x16 hi = flip(c + t), lo = flip(c - t);  // saturating
-      // Rejection test on the compass pixels 0, 4, 8, 12: an arc of 9 of the 16 always covers
-      // two neighbouring ones (0-4, 4-8, 8-12 or 12-0), i.e. (p0 or p8) and (p4 or p12).
-      const cv::v_int8x16 n = flip(cv::v_load(row + bx + circle[0])), e = flip(cv::v_load(row + bx + circle[4]));
-      const cv::v_int8x16 s = flip(cv::v_load(row + bx + circle[8])), w = flip(cv::v_load(row + bx + circle[12]));
-      const cv::v_int8x16 maybe = (((n > hi) | (s > hi)) & ((e > hi) | (w > hi))) |
-                                  (((n < lo) | (s < lo)) & ((e < lo) | (w < lo)));
-      if (!cv::v_check_any(maybe)) continue;
+      const cv::v_uint8x16 c_hi = c + t, c_lo = c - t;  // saturating
+      // Rejection tests on the compass pixels, in saturating differences (p - c_hi is nonzero
+      // exactly where p > c + t, c_lo - p where p < c - t). An arc of 9 of the 16 always covers
+      // p0 or p8 (the rest, 1..7 and 9..15, are arcs of 7): most blocks stop after those two
+      // loads. It also covers two neighbouring compass pixels (0-4, 4-8, 8-12 or 12-0), i.e.
+      // (p0 or p8) and (p4 or p12), on the same side.
+      const cv::v_uint8x16 n = cv::v_load(row + bx + circle[0]), s = cv::v_load(row + bx + circle[8]);
+      const cv::v_uint8x16 bright_ns = (n - c_hi) | (s - c_hi), dark_ns = (c_lo - n) | (c_lo - s);
+      if (!cv::v_check_any((bright_ns | dark_ns) != zero)) continue;
+      const cv::v_uint8x16 e = cv::v_load(row + bx + circle[4]), w = cv::v_load(row + bx + circle[12]);
+      const cv::v_int8x16 compass_bright = cv::v_reinterpret_as_s8(cv::v_min(bright_ns, (e - c_hi) | (w - c_hi)) != zero);
+      const cv::v_int8x16 compass_dark = cv::v_reinterpret_as_s8(cv::v_min(dark_ns, (c_lo - e) | (c_lo - w)) != zero);
+      if (!cv::v_check_any(compass_bright | compass_dark)) continue;
+      const cv::v_int8x16 hi = flip(c_hi), lo = flip(c_lo);
       // Second filter, the full count: an arc of 9 needs >= 9 of the 16 pixels on one side. It
       // also tells which sides can still have a corner, so only those get scored below.
       cv::v_uint8x16 q[16];
@@ -118,7 +128,7 @@ void FastDetector::scan(int threshold, int x0, int y0, int x1, int y1) {
         bright -= (f > hi);  // a true comparison is -1
         dark -= (f < lo);
       }
-      const cv::v_int8x16 maybe_bright = (bright >= nine) & maybe, maybe_dark = (dark >= nine) & maybe;
+      const cv::v_int8x16 maybe_bright = (bright >= nine) & compass_bright, maybe_dark = (dark >= nine) & compass_dark;
       const bool any_bright = cv::v_check_any(maybe_bright), any_dark = cv::v_check_any(maybe_dark);
       if (!any_bright && !any_dark) continue;
       // Score in saturating u8 arithmetic: with b_k = sat(I_k - c) and e_k = sat(c - I_k), the

@@ -1,8 +1,10 @@
 #include "pipeline/loop/loop_closer.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "solver/se3.h"
 #include "solver/se3_jacobians.h"
@@ -51,6 +53,7 @@ LoopCloser::LoopCloser(const CameraIntrinsics& camera, const NoiseModelOptions& 
                        const LoopCloserOptions& options)
     : options_(options),
       verifier_(camera, noise, options.verifier),
+      context_check_(camera, options.context),
       database_(databaseOptions(options)),
       graph_(options.capacity + 1, options.capacity + 1 + options.max_loop_edges),
       records_(std::size_t(options.capacity + 1)),
@@ -61,6 +64,7 @@ LoopCloser::LoopCloser(const CameraIntrinsics& camera, const NoiseModelOptions& 
   free_slots_.reserve(std::size_t(options.capacity + 1));
   for (int s = options.capacity; s >= 0; --s) free_slots_.push_back(s);
   order_.reserve(std::size_t(options.capacity + 1));
+  poses_before_.resize(std::size_t(options.capacity + 1));
   loop_edges_.reserve(std::size_t(options.max_loop_edges));
   residency_.add(records_.data(), records_.size() * sizeof(LoopCandidate));
   database_.queueReservedMemory(&residency_);
@@ -82,7 +86,11 @@ std::size_t LoopCloser::memoryBytesFor(const LoopCloserOptions& o) {
   return sizeof(LoopCloser) + slots * (sizeof(LoopCandidate) + sizeof(Node) + 2 * sizeof(int)) +
          std::size_t(o.max_loop_edges) * sizeof(LoopEdge) +
          KeyframeDatabase::memoryBytesFor(databaseOptions(o)) + graph + sparse + sizeof(LoopVerifier) +
-         110 * 1024;  // verifier scratch (~105 KB)
+         110 * 1024 +  // verifier scratch (~105 KB)
+         slots * sizeof(Eigen::Isometry3d) +  // poses before an optimisation (rollback)
+         LoopContextCheck::scratchBytes() +
+         LoopAudit::kDefaultMaxEntries * sizeof(LoopAuditEntry) +
+         LoopAudit::kDefaultMaxKeyframes * sizeof(LoopAuditKeyframe);
 }
 
 std::size_t LoopCloser::memoryBytes() const { return memoryBytesFor(options_); }
@@ -109,13 +117,23 @@ bool LoopCloser::pose(uint32_t keyframe_id, Eigen::Isometry3d* T_world_cam) cons
   return true;
 }
 
+bool LoopCloser::finalPose(uint32_t keyframe_id, Eigen::Isometry3d* T_world_cam, uint64_t* epoch) const {
+  const int p = findPosition(keyframe_id);
+  if (p < 0) return false;
+  const Node& n = nodes_[std::size_t(order_[std::size_t(p)])];
+  if (!n.has_final) return false;
+  *T_world_cam = n.T_world_final;
+  *epoch = n.final_epoch;
+  return true;
+}
+
 Matrix6d LoopCloser::edgeCovariance(bool new_segment, const Matrix6d& covariance,
                                     bool covariance_valid) const {
   if (new_segment)
     return diagonalCovariance(options_.segment_translation_sigma_m, options_.segment_rotation_sigma_rad);
   if (covariance_valid && finiteSpd(covariance)) {
     return 0.5 * (covariance + covariance.transpose()) +
-           diagonalCovariance(options_.floor_translation_sigma_m, options_.floor_rotation_sigma_rad);
+           diagonalCovariance(options_.odometry_floor_translation_sigma_m, options_.odometry_floor_rotation_sigma_rad);
   }
   return diagonalCovariance(options_.default_translation_sigma_m, options_.default_rotation_sigma_rad);
 }
@@ -124,6 +142,7 @@ void LoopCloser::addNode(const LoopKeyframe& r, int slot) {
   Node& n = nodes_[std::size_t(slot)];
   n = Node{};
   n.id = r.id;
+  n.timestamp_s = r.timestamp_s;
   n.T_world_record = r.T_world_cam;
   if (order_.empty()) {
     n.T_world_cam = r.T_world_cam;  // the graph's frame is the first keyframe's mapping frame
@@ -157,6 +176,7 @@ bool LoopCloser::addKeyframe(const LoopKeyframe& record) {
   const LoopKeyframe& r = record;
   addNode(r, slot);
   const int query_position = int(order_.size()) - 1;
+  audit_.addKeyframe(r.id, r.timestamp_s);
 
   bool accepted = false;
   // Query before inserting: a keyframe never finds itself.
@@ -176,7 +196,17 @@ bool LoopCloser::addKeyframe(const LoopKeyframe& record) {
     groups_.clear();
   }
   (void)database_.insert(r.id, descriptors);  // sized for capacity + 1: cannot fail
-  if (accepted) optimise();
+  if (accepted) {
+    for (std::size_t p = 0; p < order_.size(); ++p) poses_before_[p] = nodes_[std::size_t(order_[p])].T_world_cam;
+    optimise();
+    accepted = confirmNewestLoop();
+    if (accepted) {
+      // Which loop made the correction, for viewers: the edge just accepted, at the optimised pose.
+      const LoopEdge& edge = loop_edges_.back();
+      correction_.loop_candidate_id = edge.candidate_id;
+      if (!pose(edge.candidate_id, &correction_.T_world_candidate)) correction_.loop_candidate_id = 0;
+    }
+  }
   if (int(order_.size()) > options_.capacity) cullOne();
   stats_.graph_nodes = order_.size();
   stats_.peak_graph_nodes = std::max<uint64_t>(stats_.peak_graph_nodes, order_.size());
@@ -194,7 +224,7 @@ void LoopCloser::detect(const LoopKeyframe& query_record, int query_position) {
       const int64_t d = int64_t(g.id) - int64_t(c.keyframe_id);
       if (std::llabs(d) <= options_.consistency_neighbourhood) count = std::max(count, g.count + 1);
     }
-    (void)new_groups_.push_back(Group{uint32_t(c.keyframe_id), count});
+    (void)new_groups_.push_back(Group{uint32_t(c.keyframe_id), count, float(c.score)});
   }
   groups_ = new_groups_;
   if (cooldown_ > 0) {
@@ -211,16 +241,43 @@ void LoopCloser::detect(const LoopKeyframe& query_record, int query_position) {
     ++stats_.verifications;
     const LoopCandidate& candidate = records_[std::size_t(order_[std::size_t(candidate_position)])];
     LoopMeasurement m = verifier_.verify(query_record, candidate);
-    if (m.accepted() && !plausible(candidate_position, query_position, m))
-      m.rejection = LoopRejection::kImplausible;
+    LoopAuditEntry entry;
+    entry.query_id = query.id;
+    entry.candidate_id = candidate.id;
+    entry.query_timestamp_s = query.timestamp_s;
+    entry.candidate_timestamp_s = nodes_[std::size_t(order_[std::size_t(candidate_position)])].timestamp_s;
+    entry.place_score = g.score;
+    entry.matches = m.matches;
+    entry.ransac_inliers = m.ransac_inliers;
+    entry.point_inliers = m.refined_inliers;
+    entry.line_matches = m.line_matches;
+    entry.line_sample_inliers = m.line_inliers;
+    entry.correction_m = entry.correction_deg = entry.chi2 = std::numeric_limits<double>::quiet_NaN();
+    const Matrix6d covariance =
+        0.5 * (m.covariance + m.covariance.transpose()) +
+        diagonalCovariance(options_.floor_translation_sigma_m, options_.floor_rotation_sigma_rad);
+    if (m.accepted() && !certain(covariance)) m.rejection = LoopRejection::kUncertain;
+    if (m.accepted()) {
+      entry.T_candidate_query = m.T_candidate_query;
+      entry.covariance = covariance;
+      entry.chi2 = plausibilityChi2(candidate_position, query_position, m, &entry.correction_m, &entry.correction_deg);
+      if (!(entry.chi2 <= options_.plausibility_chi2)) m.rejection = LoopRejection::kImplausible;
+    }
+    entry.outcome = m.rejection;
+    LoopAuditEntry* stored = audit_.add(entry);
     if (!m.accepted()) {
       ++stats_.rejected[int(m.rejection)];
       continue;
     }
-    if (loop_edges_.size() >= std::size_t(options_.max_loop_edges)) loop_edges_.erase(loop_edges_.begin());
-    const Matrix6d covariance =
-        0.5 * (m.covariance + m.covariance.transpose()) +
-        diagonalCovariance(options_.floor_translation_sigma_m, options_.floor_rotation_sigma_rad);
+    pending_ = PendingLoop{};
+    pending_.active = true;
+    pending_.candidate_id = candidate.id;
+    pending_.audit = stored;
+    if (loop_edges_.size() >= std::size_t(options_.max_loop_edges)) {
+      pending_.evicted_edge = true;
+      pending_.evicted = loop_edges_.front();
+      loop_edges_.erase(loop_edges_.begin());
+    }
     loop_edges_.push_back(LoopEdge{candidate.id, query.id, m.T_candidate_query, inverseSpd(covariance)});
     ++stats_.loops_accepted;
     cooldown_ = options_.cooldown_keyframes;
@@ -228,7 +285,8 @@ void LoopCloser::detect(const LoopKeyframe& query_record, int query_position) {
   }
 }
 
-bool LoopCloser::plausible(int candidate_position, int query_position, const LoopMeasurement& m) const {
+double LoopCloser::plausibilityChi2(int candidate_position, int query_position, const LoopMeasurement& m,
+                                    double* correction_m, double* correction_deg) const {
   const Node& c = nodes_[std::size_t(order_[std::size_t(candidate_position)])];
   const Node& q = nodes_[std::size_t(order_[std::size_t(query_position)])];
   const Eigen::Isometry3d T_cam_q_world = q.T_world_cam.inverse();
@@ -243,8 +301,12 @@ bool LoopCloser::plausible(int candidate_position, int query_position, const Loo
   }
   sigma += diagonalCovariance(options_.floor_translation_sigma_m, options_.floor_rotation_sigma_rad);
   const Vector6d e = poseGraphEdgeError(m.T_candidate_query, c.T_world_cam.inverse(), T_cam_q_world);
+  // The query's current pose seen from where the loop puts it: how far the correction moves it.
+  const Eigen::Isometry3d E = m.T_candidate_query.inverse() * c.T_world_cam.inverse() * q.T_world_cam;
+  *correction_m = E.translation().norm();
+  *correction_deg = Eigen::AngleAxisd(E.linear()).angle() * 180.0 / M_PI;
   const double chi2 = e.dot(Eigen::LDLT<Matrix6d>(sigma).solve(e));
-  return std::isfinite(chi2) && chi2 <= options_.plausibility_chi2;
+  return std::isfinite(chi2) ? chi2 : std::numeric_limits<double>::infinity();
 }
 
 void LoopCloser::keyframeFinal(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam,
@@ -292,14 +354,80 @@ void LoopCloser::optimise() {
       nodes_[std::size_t(order_[p])].T_world_cam = graph_.pose(int(p)).inverse();
     }
   }
+  // The real-time correction is anchored to the candidate as the robot had it (docs/LOOP.md "What
+  // the robot receives"): the query goes where the loop says it is relative to the candidate's
+  // pose when it was made (its record's; its final local-map pose may already carry corrections
+  // made while it was still in the local map), so a place the robot returns to gets the
+  // coordinates it had before. The graph's optimum (which moves the old side too, but not what
+  // was already output) is the optimised trajectory's.
   const Node& query = nodes_[std::size_t(order_.back())];
   correction_.keyframe_id = query.id;
   correction_.T_world_cam = query.T_world_cam;
+  if (!loop_edges_.empty() && loop_edges_.back().query_id == query.id) {
+    const int c = findPosition(loop_edges_.back().candidate_id);
+    if (c >= 0) {
+      const Node& candidate = nodes_[std::size_t(order_[std::size_t(c)])];
+      correction_.T_world_cam = candidate.T_world_record * loop_edges_.back().T_candidate_query;
+    }
+  }
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   ++stats_.optimisations;
   stats_.optimisation_ms_total += ms;
   stats_.optimisation_ms_max = std::max(stats_.optimisation_ms_max, ms);
+}
+
+bool LoopCloser::certain(const Matrix6d& covariance) const {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> t(covariance.topLeftCorner<3, 3>(), Eigen::EigenvaluesOnly);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> r(covariance.bottomRightCorner<3, 3>(), Eigen::EigenvaluesOnly);
+  const double max_t = options_.max_loop_sigma_m, max_r = options_.max_loop_sigma_rad;
+  return t.info() == Eigen::Success && r.info() == Eigen::Success && t.eigenvalues().maxCoeff() <= max_t * max_t &&
+         r.eigenvalues().maxCoeff() <= max_r * max_r;
+}
+
+bool LoopCloser::confirmNewestLoop() {
+  const bool was_pending = pending_.active;
+  pending_.active = false;
+  if (!was_pending || !options_.context_check) return was_pending;
+  const int query_position = int(order_.size()) - 1;
+  const int candidate_position = findPosition(pending_.candidate_id);
+  if (candidate_position < 0) return true;
+  // Query side: the query and its predecessors; candidate side: the candidate, then its
+  // neighbours alternately after and before it. Both as the graph had them and as optimised.
+  LoopContextSide query, candidate;
+  auto add = [&](LoopContextSide* side, int p) {
+    if (side->count >= 8) return;
+    const int slot = order_[std::size_t(p)];
+    side->records[side->count] = &records_[std::size_t(slot)];
+    side->T_world_before[side->count] = poses_before_[std::size_t(p)];
+    side->T_world_after[side->count] = nodes_[std::size_t(slot)].T_world_cam;
+    ++side->count;
+  };
+  add(&query, query_position);
+  for (int k = 1; k <= options_.context.query_neighbours && query_position - k > candidate_position; ++k)
+    add(&query, query_position - k);
+  add(&candidate, candidate_position);
+  for (int k = 1; k <= options_.context.candidate_neighbours; ++k) {
+    if (candidate_position + k < query_position - options_.context.query_neighbours) add(&candidate, candidate_position + k);
+    if (candidate_position - k >= 0) add(&candidate, candidate_position - k);
+  }
+  const LoopContextResult r = context_check_.evaluate(query, candidate);
+  if (pending_.audit != nullptr) {
+    pending_.audit->context_matches = r.matches;
+    pending_.audit->context_cost_before = r.cost_before;
+    pending_.audit->context_cost_after = r.cost_after;
+  }
+  if (context_check_.accepts(r)) return true;
+  // Roll back: the graph as it was, the loop edge gone (and the one it evicted back), nothing
+  // published, counted as a rejection.
+  for (std::size_t p = 0; p < order_.size(); ++p) nodes_[std::size_t(order_[p])].T_world_cam = poses_before_[p];
+  loop_edges_.pop_back();
+  if (pending_.evicted_edge) loop_edges_.insert(loop_edges_.begin(), pending_.evicted);
+  if (pending_.audit != nullptr) pending_.audit->outcome = LoopRejection::kRolledBack;
+  --stats_.loops_accepted;
+  ++stats_.rejected[int(LoopRejection::kRolledBack)];
+  cooldown_ = 0;
+  return false;
 }
 
 void LoopCloser::cullOne() {

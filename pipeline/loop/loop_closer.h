@@ -4,7 +4,8 @@
 //
 // addKeyframe(record), for each keyframe the mapping side inserted, in id order:
 //   1. graph: a node for the keyframe, linked to the previous node by an odometry edge
-//      T_previous_this weighted by the local-BA marginal covariance (+ a floor), or by a default
+//      T_previous_this weighted by its calibrated covariance from local BA's joint marginal
+//      (docs/UNCERTAINTY.md; + a numerical floor only), or by a default
 //      information when BA gave none; a new map segment is linked by a weak edge.
 //   2. detection: KeyframeDatabase query, candidates older than min_age_keyframes (outside the
 //      local window); a candidate must be consistent over min_consistent consecutive queries
@@ -35,9 +36,12 @@
 #include <vector>
 
 #include "pipeline/loop/keyframe_database.h"
+#include "pipeline/loop/loop_audit.h"
+#include "pipeline/loop/loop_context_check.h"
 #include "pipeline/loop/loop_keyframe.h"
 #include "pipeline/loop/loop_verifier.h"
 #include "pipeline/loop/saved_map.h"
+#include "pipeline/odometry/map_capacities.h"
 #include "pipeline/odometry/map_correction.h"
 #include "solver/pose_graph.h"
 
@@ -46,7 +50,11 @@ namespace plumb::loop {
 struct LoopCloserOptions {
   int capacity = 128;          // keyframe records = database entries = graph nodes (docs/LOOP.md "Memory")
   int max_loop_edges = 24;     // the oldest loop edge is forgotten when full
-  int min_age_keyframes = 40;  // candidate id <= query id - this (the local map holds 32)
+  // candidate id <= query id - this: outside the local map (kMaxMapKeyframes = 32 keyframes), whose
+  // own BA already ties the query to everything younger. (It was 40: with ~37 keyframes per lap
+  // of a room, that left only places visited EARLIER on the previous lap as candidates, i.e.
+  // long-baseline loops seen from 1-2 m away, instead of the revisit itself.)
+  int min_age_keyframes = int(kMaxMapKeyframes) + 1;
   int candidates = 10;         // database results per query
   double min_candidate_score = 0.02;
   int consistency_neighbourhood = 4;  // candidate ids this close name the same place
@@ -55,10 +63,20 @@ struct LoopCloserOptions {
   int cooldown_keyframes = 3;         // after an accepted loop, keyframes not searched
   LoopVerifierOptions verifier;
   int bits_per_word = kDefaultWordBits;
-  // Odometry edge covariance when local BA gave none; the floor is added to BA's covariances,
-  // which know the measurement noise only (not the model errors that make odometry drift).
+  // Odometry edge covariance when local BA gave none.
   double default_translation_sigma_m = 0.02;
   double default_rotation_sigma_rad = 0.01;
+  // Added to BA's covariance of an odometry edge: numerical only (every edge's information stays
+  // finite), 30x and 20x below the 3 mm / 0.002 rad model floor these edges had before. BA's
+  // relative covariances are calibrated (variance factor, correlation factor, rolling-shutter
+  // model error: docs/UNCERTAINTY.md), so they already carry the model errors that make odometry
+  // drift; a model floor on top dominated them 3-10x, weighted every edge alike whatever BA knew,
+  // and a loop's correction then went into the edges that had no error (docs/LOOP.md "Why a
+  // correct loop made the optimised trajectory worse").
+  double odometry_floor_translation_sigma_m = 1e-4;
+  double odometry_floor_rotation_sigma_rad = 1e-4;
+  // Added to the loop edge's covariance (the verifier's, not calibrated: it holds the candidate's
+  // points exact) and to the plausibility test's sum.
   double floor_translation_sigma_m = 0.003;
   double floor_rotation_sigma_rad = 0.002;
   // The first keyframe of a new map segment: the tracker restarted at its last known pose.
@@ -69,7 +87,19 @@ struct LoopCloserOptions {
   double drift_translation_per_m = 0.03;
   double drift_rotation_rad_per_m = 0.02;
   double plausibility_chi2 = 22.46;
+  // Certainty of the measurement itself: a loop whose verification pins the relative pose no
+  // better than this (1 sigma along its worst translation axis / rotation axis, from the
+  // refinement's covariance) is rejected as `uncertain`: a view of the same place from metres
+  // away, dominated by far points, measures the loop by centimetres at best, and a correction
+  // that uncertain can only add noise to drift of the same size.
+  double max_loop_sigma_m = 0.03;
+  double max_loop_sigma_rad = 0.0175;  // 1 deg
   double loop_huber_delta = 2.8;  // whitened (sqrt chi-square); ~95% of a 6-dof inlier's chi
+  // Do no harm: after the graph is optimised with a new loop, the covisible landmarks of the
+  // keyframes around both sides must be explained at least as well as before, or the loop is
+  // rolled back (loop_context_check.h). Off: every verified, plausible loop is applied.
+  bool context_check = true;
+  LoopContextCheckOptions context;
   PoseGraphOptions graph;
 };
 
@@ -124,9 +154,14 @@ class LoopCloser {
 
   // The graph's current pose of a keyframe (optimised after a loop); false if not in the graph.
   bool pose(uint32_t keyframe_id, Eigen::Isometry3d* T_world_cam) const;
+  // Its final local-map pose and the loop epoch it was reported in (keyframeFinal); false if the
+  // keyframe is not in the graph or never left the local map.
+  bool finalPose(uint32_t keyframe_id, Eigen::Isometry3d* T_world_cam, uint64_t* epoch) const;
   std::size_t size() const { return order_.size(); }
   std::size_t capacity() const { return std::size_t(options_.capacity); }
   const LoopStats& stats() const { return stats_; }
+  // Every candidate that reached verification and what became of it (loop_audit.h).
+  const LoopAudit& audit() const { return audit_; }
   const LoopCloserOptions& options() const { return options_; }
   // Ids in the graph, ascending.
   uint32_t idAt(std::size_t i) const { return nodes_[std::size_t(order_[i])].id; }
@@ -140,6 +175,7 @@ class LoopCloser {
  private:
   struct Node {
     uint32_t id = 0;
+    double timestamp_s = 0;  // the record's (0 for a keyframe loaded from a map file)
     Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();     // graph estimate
     Eigen::Isometry3d T_world_record = Eigen::Isometry3d::Identity();  // the record's, at creation
     bool has_edge = false;                                          // from the previous node in order_
@@ -156,18 +192,26 @@ class LoopCloser {
   struct Group {
     uint32_t id = 0;
     int count = 0;
+    float score = 0;
   };
 
   int findPosition(uint32_t id) const;  // index into order_, -1 if absent
   void addNode(const LoopKeyframe& record, int slot);
   void cullOne();
   void detect(const LoopKeyframe& query_record, int query_position);
-  bool plausible(int candidate_position, int query_position, const LoopMeasurement& m) const;
+  // The plausibility chi-square of the loop (step 4) and the correction it implies.
+  double plausibilityChi2(int candidate_position, int query_position, const LoopMeasurement& m,
+                          double* correction_m, double* correction_deg) const;
   void optimise();
+  // After optimise() with the loop just accepted: the do-no-harm check; false = rolled back.
+  bool confirmNewestLoop();
+  // The loop edge's covariance is within max_loop_sigma_m / max_loop_sigma_rad.
+  bool certain(const Matrix6d& covariance) const;
   Matrix6d edgeCovariance(bool new_segment, const Matrix6d& covariance, bool covariance_valid) const;
 
   LoopCloserOptions options_;
   LoopVerifier verifier_;
+  LoopContextCheck context_check_;
   KeyframeDatabase database_;
   PoseGraph graph_;
   // By slot: what verification needs of each keyframe as a candidate, for the full capacity. From
@@ -181,9 +225,20 @@ class LoopCloser {
   FixedVector<Group, kMaxPlaceCandidates> groups_, new_groups_;
   PlaceCandidates candidates_;
   int cooldown_ = 0;
+  // The loop accepted by detect() for this keyframe, until confirmNewestLoop() keeps or undoes it.
+  struct PendingLoop {
+    bool active = false;
+    uint32_t candidate_id = 0;
+    bool evicted_edge = false;  // the oldest loop edge was forgotten to make room
+    LoopEdge evicted;
+    LoopAuditEntry* audit = nullptr;  // may be null (audit full)
+  };
+  PendingLoop pending_;
+  std::vector<Eigen::Isometry3d> poses_before_;  // by position in order_, before the optimisation
   bool edges_changed_ = false;  // since the last optimisation
   MapCorrection correction_;
   LoopStats stats_;
+  LoopAudit audit_;
   ResidencyQueue residency_;  // records_, the database's postings, the graph's reserved arrays
 };
 

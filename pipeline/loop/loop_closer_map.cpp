@@ -94,6 +94,7 @@ Status LoopCloser::restoreMap(const SavedMap& map) {
     Node& n = nodes_[std::size_t(slot)];
     n = Node{};
     n.id = k.record.id;
+    n.timestamp_s = k.record.timestamp_s;
     n.T_world_cam = k.T_world_cam;
     n.T_world_record = k.record.T_world_cam;
     n.has_edge = k.has_edge;

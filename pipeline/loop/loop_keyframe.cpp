@@ -86,6 +86,12 @@ bool makeLoopKeyframe(const KeyframeRequest& request, uint32_t keyframe_id, bool
   if (!new_segment && previous_slot >= 0) {
     out->previous_id = map.keyframe(previous_slot).id;
     out->T_previous_this = map.keyframe(previous_slot).T_world_cam.inverse() * kf.T_world_cam;
+    // The covariance of exactly this relative pose (local BA's joint marginal, calibrated:
+    // docs/UNCERTAINTY.md) when that BA held both keyframes; the marginal otherwise.
+    if (kf.uncertainty.previous_id == out->previous_id) {
+      out->covariance = kf.uncertainty.relative_covariance;
+      out->covariance_valid = true;
+    }
   }
   fillLoopFeatures(request.features, out);
   return true;

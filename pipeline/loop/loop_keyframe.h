@@ -10,8 +10,9 @@
 //   lines:  the first kMaxLoopLines lines with a 3D fit: LBD descriptor, normalised 2D line, octave
 //           and the line-guidance samples in the camera frame (the refinement's line errors);
 //   odometry: the pose of this keyframe relative to the previous keyframe of the map, taken from the
-//           mapper's poses right after this keyframe's local BA, and this keyframe's marginal
-//           covariance from that BA (the pose graph's odometry edge and its weight).
+//           mapper's poses right after this keyframe's local BA, and the covariance of that relative
+//           pose from the BA's joint marginal, calibrated (the pose graph's odometry edge and its
+//           weight; docs/UNCERTAINTY.md).
 // Size: sizeof(LoopKeyframe), ~47 KB (computed in tests/loop/loop_keyframe_test.cpp). The closer
 // keeps only a LoopCandidate of each record (below): what verification reads of a CANDIDATE.
 #include <Eigen/Core>
@@ -57,7 +58,10 @@ struct LoopKeyframe {
   uint32_t previous_id = 0;  // previous keyframe of the map (0: none)
   Eigen::Isometry3d T_previous_this = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();  // mapping frame, at creation
-  Matrix6d covariance = Matrix6d::Zero();  // local BA marginal ([rho; phi], left on T_cam_world)
+  // Covariance of T_previous_this (its right perturbation, the pose graph's edge error) from local
+  // BA's joint marginal, calibrated (KeyframeUncertainty); the keyframe's marginal ([rho; phi],
+  // left on T_cam_world) when no BA held both keyframes.
+  Matrix6d covariance = Matrix6d::Zero();
   bool covariance_valid = false;
 
   FixedVector<LoopPoint, kMaxLoopPoints> points;

@@ -1,7 +1,10 @@
 #include "pipeline/loop/loop_verifier.h"
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 
+#include "pipeline/frontend/descriptor_match.h"
 #include "solver/pose_optimizer.h"
 
 namespace plumb::loop {
@@ -20,6 +23,10 @@ const char* toString(LoopRejection r) {
       return "refinement";
     case LoopRejection::kImplausible:
       return "implausible_correction";
+    case LoopRejection::kUncertain:
+      return "uncertain";
+    case LoopRejection::kRolledBack:
+      return "rolled_back";
   }
   return "?";
 }
@@ -42,27 +49,38 @@ LoopVerifier::LoopVerifier(const CameraIntrinsics& camera, const NoiseModelOptio
 
 LoopVerifier::~LoopVerifier() = default;
 
-namespace {
-
-// Index of the best descriptor in [0, n) for d if it passes the threshold and ratio test, else -1.
-int bestMatch(const Descriptor256& d, const Descriptor256* others, std::size_t n, int threshold,
-              float ratio) {
-  int best = 256, second = 256, best_index = -1;
-  for (std::size_t j = 0; j < n; ++j) {
-    const int dist = hammingDistance(d, others[j]);
-    if (dist < best) {
-      second = best;
-      best = dist;
-      best_index = int(j);
-    } else if (dist < second) {
-      second = dist;
-    }
+bool LoopVerifier::lineAgrees(const LoopLine& query_line, const Eigen::Vector3f* candidate_samples,
+                              std::size_t count, const Eigen::Isometry3d& T_query_candidate) const {
+  if (count < 2 || query_line.num_samples < 2) return false;
+  const Eigen::Vector3d l = query_line.l.cast<double>();
+  const Eigen::Vector2d direction(-l.y(), l.x());  // along the line (l is normalised: a^2 + b^2 = 1)
+  auto pixel = [this](const Eigen::Vector3d& P) {
+    return Eigen::Vector2d(camera_.fx * P.x() / P.z() + camera_.cx, camera_.fy * P.y() / P.z() + camera_.cy);
+  };
+  // Extent of the query segment along its line, from its own samples.
+  double q_lo = INFINITY, q_hi = -INFINITY;
+  for (std::size_t s = 0; s < query_line.num_samples; ++s) {
+    const Eigen::Vector3d P = query_line.samples_cam[s].cast<double>();
+    if (!(P.z() > 0)) continue;
+    const double t = direction.dot(pixel(P));
+    q_lo = std::min(q_lo, t);
+    q_hi = std::max(q_hi, t);
   }
-  if (best_index < 0 || best > threshold || float(best) >= ratio * float(second)) return -1;
-  return best_index;
+  const double gate = options_.line_gate_px * std::pow(1.2, std::max<int>(0, query_line.octave));  // ORB pyramid scale
+  int close = 0;
+  double c_lo = INFINITY, c_hi = -INFINITY;
+  for (std::size_t s = 0; s < count; ++s) {
+    const Eigen::Vector3d X = T_query_candidate * candidate_samples[s].cast<double>();
+    if (!(X.z() > 0.05)) continue;
+    const Eigen::Vector2d p = pixel(X);
+    if (std::abs(l.dot(p.homogeneous())) <= gate) ++close;
+    const double t = direction.dot(p);
+    c_lo = std::min(c_lo, t);
+    c_hi = std::max(c_hi, t);
+  }
+  const bool overlap = c_lo <= q_hi && q_lo <= c_hi;
+  return overlap && double(close) >= options_.line_gate_min_fraction * double(count);
 }
-
-}  // namespace
 
 LoopMeasurement LoopVerifier::verify(const LoopKeyframe& query, const LoopCandidate& candidate) {
   LoopMeasurement m;
@@ -70,7 +88,7 @@ LoopMeasurement LoopVerifier::verify(const LoopKeyframe& query, const LoopCandid
   // 1. Points.
   int n = 0;
   for (std::size_t k = 0; k < query.points.size(); ++k) {
-    const int j = bestMatch(query.point_descriptors[k], candidate.point_descriptors.data(),
+    const int j = bestRatioMatch(query.point_descriptors[k], candidate.point_descriptors.data(),
                             candidate.num_points, options_.hamming_threshold, options_.ratio);
     if (j < 0) continue;
     s.query_index[std::size_t(n)] = uint16_t(k);
@@ -112,19 +130,24 @@ LoopMeasurement LoopVerifier::verify(const LoopKeyframe& query, const LoopCandid
   }
   int num_lines = 0;
   if (options_.use_lines) {
+    const Eigen::Isometry3d T_qc = T_cq.inverse();
     for (std::size_t k = 0; k < query.lines.size(); ++k) {
       const int j =
-          bestMatch(query.line_descriptors[k], candidate.line_descriptors.data(), candidate.num_lines,
+          bestRatioMatch(query.line_descriptors[k], candidate.line_descriptors.data(), candidate.num_lines,
                     options_.line_hamming_threshold, options_.line_ratio);
       if (j < 0) continue;
-      ++m.line_matches;
       const std::size_t first = candidate.first_sample[std::size_t(j)];
+      const std::size_t count = candidate.num_samples[std::size_t(j)];
       const LoopLine& q = query.lines[k];
-      for (std::size_t smp = 0; smp < candidate.num_samples[std::size_t(j)]; ++smp) {
+      if (!lineAgrees(q, &candidate.samples_cam[first], count, T_qc)) continue;
+      ++m.line_matches;
+      const double information = lineSampleInformation(noise_, q.octave) /
+                                 (options_.line_information_per_line ? double(count) : 1.0);
+      for (std::size_t smp = 0; smp < count; ++smp) {
         PoseLineObservation& obs = s.pose_lines[std::size_t(num_lines++)];
         obs.P_world = candidate.samples_cam[first + smp].cast<double>();
         obs.line = q.l.cast<double>();
-        obs.information = lineSampleInformation(noise_, q.octave);
+        obs.information = information;
       }
     }
   }

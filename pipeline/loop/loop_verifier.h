@@ -2,7 +2,7 @@
 // LoopVerifier: decides whether two LoopKeyframe records see the same place, and if so measures
 // their relative pose (docs/LOOP.md "Verification"):
 //   1. ORB matching query -> candidate: brute-force Hamming, absolute threshold + Lowe ratio;
-//   2. rigid 3D-3D RANSAC on the matched points (both have depth): rigid_ransac.h;
+//   2. rigid 3D-3D RANSAC on the matched points (both have depth): solver/rigid_fit.h;
 //   3. refinement of T_query_candidate with the pose-only optimiser (solver/pose_optimizer.h):
 //      the candidate's 3D points against the query's [u, v, u_r] observations (RANSAC inliers),
 //      plus the candidate's line-guidance samples against the query's 2D lines for LBD matches;
@@ -17,9 +17,9 @@
 #include <memory>
 
 #include "pipeline/loop/loop_keyframe.h"
-#include "pipeline/loop/rigid_ransac.h"
 #include "solver/camera_intrinsics.h"
 #include "solver/noise_model.h"
+#include "solver/rigid_fit.h"
 #include "solver/types.h"
 
 namespace plumb::loop {
@@ -30,6 +30,17 @@ struct LoopVerifierOptions {
   int line_hamming_threshold = 60;  // LBD
   float line_ratio = 0.8f;
   bool use_lines = true;  // line-guidance errors in the refinement
+  // A line match (LBD descriptors alone: long parallel edges of windows, shelves and desks look
+  // alike) enters the refinement only when the RANSAC pose of the points puts the candidate's
+  // samples on the query's line: at least `line_gate_min_fraction` of them within
+  // `line_gate_px` of it (sample pixels scaled by the octave), and overlapping the query
+  // segment's own samples along it.
+  double line_gate_px = 4.0;
+  double line_gate_min_fraction = 0.6;
+  // The N samples of one line are not N independent measurements of the pose (they share the 2D
+  // fit and the 3D fit of one segment): each carries 1/N of a sample's information, so a line
+  // weighs like one measurement in the refinement and in the loop edge's covariance.
+  bool line_information_per_line = true;
   int min_matches = 40;
   RigidRansacOptions ransac;
   int min_inliers = 35;           // RANSAC inliers
@@ -44,8 +55,11 @@ enum class LoopRejection : uint8_t {
   kLowInlierRatio,
   kRefinement,   // refinement lost the inliers (or its covariance was degenerate)
   kImplausible,  // LoopCloser: the implied correction is beyond the odometry uncertainty
+  kUncertain,    // LoopCloser: the measured relative pose is too uncertain to correct anything
+  kRolledBack,   // LoopCloser: the corrected graph explains the covisible landmarks of both sides
+                 // worse than before (loop_context_check.h): undone, never published
 };
-constexpr int kNumLoopRejections = 6;
+constexpr int kNumLoopRejections = 8;
 const char* toString(LoopRejection r);
 
 struct LoopMeasurement {
@@ -58,8 +72,8 @@ struct LoopMeasurement {
   int matches = 0;
   int ransac_inliers = 0;
   int refined_inliers = 0;
-  int line_matches = 0;
-  int line_inliers = 0;
+  int line_matches = 0;  // LBD matches that passed the gate at the RANSAC pose
+  int line_inliers = 0;   // their samples inlying after refinement
   bool accepted() const { return rejection == LoopRejection::kNone; }
 };
 
@@ -76,6 +90,9 @@ class LoopVerifier {
   const LoopVerifierOptions& options() const { return options_; }
 
  private:
+  // The gate of a line match (options above), at the RANSAC pose.
+  bool lineAgrees(const LoopLine& query_line, const Eigen::Vector3f* candidate_samples, std::size_t count,
+                  const Eigen::Isometry3d& T_query_candidate) const;
   struct Scratch;
   CameraIntrinsics camera_;
   NoiseModelOptions noise_;

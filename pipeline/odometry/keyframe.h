@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include "pipeline/frontend/capacities.h"
+#include "pipeline/odometry/keyframe_uncertainty.h"
 #include "pipeline/odometry/map_capacities.h"
 #include "platform/fixed_vector.h"
 
@@ -43,6 +44,7 @@ struct Keyframe {
   // the solver's SE(3) perturbation); zero until then.
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
   bool covariance_valid = false;
+  KeyframeUncertainty uncertainty;  // relative to the previous keyframe, and in the world frame
   FixedVector<KeyframePointObservation, kMaxKeypoints> points;
   FixedVector<KeyframeLineObservation, kMaxLines> lines;
 };

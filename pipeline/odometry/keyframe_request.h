@@ -26,6 +26,10 @@ struct KeyframeRequest {
   double timestamp_s = 0;
   Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
   uint64_t local_map_version = 0;  // snapshot the associations refer to
+  // The camera's velocity when the frame was tracked, a twist per second of the left perturbation
+  // of T_cam_world (T_cam_world(t + dt) ~ exp(twist dt) T_cam_world(t)); zero when unknown. For the
+  // timing model error of the published covariances (docs/UNCERTAINTY.md).
+  Eigen::Matrix<double, 6, 1> twist_per_s = Eigen::Matrix<double, 6, 1>::Zero();
   FrameFeatures features;
   // Per keypoint / line: the landmark it was matched to as an inlier (id 0 = none).
   std::array<LandmarkRef, kMaxKeypoints> keypoint_landmark{};

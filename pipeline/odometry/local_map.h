@@ -49,8 +49,18 @@ struct LocalMap {
   uint32_t reference_keyframe_id = 0;
   uint64_t reference_keyframe_sequence = 0;
   Eigen::Isometry3d T_world_reference = Eigen::Isometry3d::Identity();
+  // The reference keyframe's world covariance (KeyframeUncertainty), what the tracked pose's
+  // published covariance builds on; invalid: the tracked pose gets none.
+  Eigen::Matrix<double, 6, 6> reference_world_covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  bool reference_world_covariance_valid = false;
   int reference_tracked_landmarks = 0;  // landmarks of the reference KF observed by >= 2 keyframes
   int keyframes_in_map = 0;
+  // Loop corrections the mapper has applied to this map segment so far, and their composition
+  // (maps a point of the world before the first of them to the world now). A tracker holding
+  // 3D points from an older snapshot moves ALL of them by the difference (Tracker::setLocalMap):
+  // a correction moves every landmark, not only those this snapshot lists.
+  uint64_t loop_corrections = 0;
+  Eigen::Isometry3d T_loop_corrections = Eigen::Isometry3d::Identity();
   FixedVector<LocalMapKeyframe, kMaxMapKeyframes> keyframes;  // every keyframe in the map, by id
   FixedVector<LocalMapPoint, kMaxLocalMapPoints> points;
   FixedVector<LocalMapLine, kMaxLocalMapLines> lines;
@@ -58,8 +68,11 @@ struct LocalMap {
   void clear() {
     version = 0;
     reference_keyframe_id = 0;
+    reference_world_covariance_valid = false;
     reference_tracked_landmarks = 0;
     keyframes_in_map = 0;
+    loop_corrections = 0;
+    T_loop_corrections = Eigen::Isometry3d::Identity();
     keyframes.clear();
     points.clear();
     lines.clear();

@@ -15,6 +15,7 @@ LocalMapper::LocalMapper(const PinholeCamera& camera, const OdometryOptions& opt
   intrinsics_ = CameraIntrinsics{camera.fx, camera.fy, camera.cx, camera.cy, camera.fx * camera.baseline_m};
   const LocalMapperOptions& m = options.mapper;
   ba_options_.max_iterations = m.ba_iterations;
+  ba_options_.function_tolerance = m.ba_function_tolerance;
   ba_options_.chi2 = m.chi2;
   const int max_keyframes = m.ba_optimised_keyframes + m.ba_fixed_keyframes;
   const int max_observations = m.max_ba_landmarks * 8;
@@ -35,6 +36,7 @@ void LocalMapper::retireKeyframe(int kf_slot) {
   r.T_world_cam = kf.T_world_cam;
   r.covariance = kf.covariance;
   r.covariance_valid = kf.covariance_valid;
+  r.uncertainty = kf.uncertainty;
   // retired_ is drained by the caller after every insertion; when it is not, the oldest report
   // is the one dropped (the output is a courtesy, the map must stay bounded).
   if (retired_.full()) {
@@ -55,6 +57,8 @@ InsertResult LocalMapper::insertKeyframe(const KeyframeRequest& request) {
   if (request.start_new_map) {
     retireAll();
     map_.clear();
+    loop_corrections_ = 0;
+    T_loop_corrections_ = Eigen::Isometry3d::Identity();
     ++segment_;
     ++stats_.segments;
   } else if (map_.counts().keyframes == 0) {
@@ -66,9 +70,19 @@ InsertResult LocalMapper::insertKeyframe(const KeyframeRequest& request) {
   kf.frame_sequence = request.frame_sequence;
   kf.timestamp_s = request.timestamp_s;
   kf.T_world_cam = request.T_world_cam;
+  kf.uncertainty.twist_per_s = request.twist_per_s;
   // Tracked against a snapshot from before the last loop correction: move it with the map.
   if (!request.start_new_map && request.local_map_version < correction_version_) {
     kf.T_world_cam = last_correction_ * request.T_world_cam;
+  }
+  if (request.start_new_map) {
+    // The world frame is the first map's first keyframe (exact); a later segment starts at the
+    // last known pose, a guess (docs/UNCERTAINTY.md).
+    const UncertaintyOptions& u = options_.uncertainty;
+    kf.uncertainty.world_covariance =
+        segment_ <= 1 ? Eigen::Matrix<double, 6, 6>::Zero()
+                      : diagonalPoseCovariance(u.segment_translation_sigma_m, u.segment_rotation_sigma_rad);
+    kf.uncertainty.world_covariance_valid = true;
   }
   result.inserted = true;
   result.keyframe_id = kf.id;
@@ -112,6 +126,8 @@ bool LocalMapper::applyCorrection(const MapCorrection& correction) {
     l.end_world = C * l.end_world;
   }
   last_correction_ = C;
+  ++loop_corrections_;
+  T_loop_corrections_ = C * T_loop_corrections_;
   publishSnapshot(map_.newestKeyframeSlot());
   correction_version_ = local_map_->version;
   return true;

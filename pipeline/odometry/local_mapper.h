@@ -33,6 +33,7 @@ struct RetiredKeyframe {
   Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
   bool covariance_valid = false;
+  KeyframeUncertainty uncertainty;
 };
 
 struct MapperStats {
@@ -84,6 +85,8 @@ class LocalMapper {
 
   // Keyframes retired since the last clearRetired(), in retirement order.
   const FixedVector<RetiredKeyframe, kMaxMapKeyframes>& retired() const { return retired_; }
+  // The rigid motion the last applied loop correction moved the map by (applyCorrection's C).
+  const Eigen::Isometry3d& lastCorrection() const { return last_correction_; }
   void clearRetired() { retired_.clear(); }
   // Retires every keyframe still in the map (end of a run), oldest first.
   void retireAll();
@@ -100,6 +103,13 @@ class LocalMapper {
   // local_mapper_ba.cpp
   void runLocalBa(int kf_slot, InsertResult* result);
   void selectWindow(int kf_slot);
+  void excludeSingleViewLandmarks();
+  void moveSingleViewLandmarks();
+  // local_mapper_covariance.cpp: after a BA's covariance, every window keyframe's relative pose
+  // and covariance to its previous keyframe (when that BA held both); the new keyframe's world
+  // covariance chained from its previous keyframe's.
+  void writeUncertainty(int kf_slot, bool have_covariance, double variance_factor);
+  int previousKeyframeSlot(uint32_t id) const;
   // local_mapper_snapshot.cpp
   void publishSnapshot(int kf_slot);
   void rankCovisible(int kf_slot, int count, FixedVector<int, kMaxMapKeyframes>* out) const;
@@ -115,6 +125,9 @@ class LocalMapper {
   // The last correction: snapshots older than this version are in the frame before it.
   uint64_t correction_version_ = 0;
   Eigen::Isometry3d last_correction_ = Eigen::Isometry3d::Identity();
+  // Loop corrections applied in this map segment and their composition (LocalMap's fields).
+  uint64_t loop_corrections_ = 0;
+  Eigen::Isometry3d T_loop_corrections_ = Eigen::Isometry3d::Identity();
   MapperStats stats_;
   FixedVector<RetiredKeyframe, kMaxMapKeyframes> retired_;
 
@@ -129,6 +142,11 @@ class LocalMapper {
     std::array<int, kMaxMapKeyframes> ba_keyframe_index{};  // slot -> BA keyframe index
     FixedVector<uint32_t, kMaxMapPoints> ba_points;   // BA landmark order: point slots ...
     FixedVector<uint32_t, kMaxMapLines> ba_lines;     // ... then line slots (samples consecutive)
+    // Landmarks of the window seen by one BA keyframe only: left out of the BA and moved
+    // rigidly with that keyframe afterwards (local_mapper_ba.cpp, excludeSingleViewLandmarks).
+    FixedVector<uint32_t, kMaxMapPoints> single_view_points;
+    FixedVector<uint32_t, kMaxMapLines> single_view_lines;
+    std::array<Eigen::Isometry3d, kMaxMapKeyframes> ba_correction;  // T_world_cam new * old^-1
     FixedVector<std::pair<float, uint16_t>, kMaxKeypoints> new_point_order;
     FixedVector<std::pair<float, uint32_t>, kMaxMapPoints> retire_order;
   };

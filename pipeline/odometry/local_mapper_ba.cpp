@@ -78,6 +78,72 @@ void LocalMapper::selectWindow(int kf_slot) {
   }
 }
 
+// A landmark observed by a single keyframe of the BA (typically the points and lines the new
+// keyframe just created) has as many unknowns as its observation has residuals or more (3 for a
+// stereo point, 2 for a mono point, 1 for a line sample), so at the optimum its residual is zero
+// and it contributes exactly nothing to the poses: eliminating it gives W H_ll^-1 W^T = the
+// pose block it added (the Schur complement cancels), for the solution and for the covariance
+// alike. What BA does with it is carry it along with its keyframe. So it is left out of the
+// problem (about 45% of the landmarks and 20% of the observations of a window on fr1/rpy) and
+// moved rigidly with its keyframe's correction afterwards, which is that optimum exactly; one
+// seen only by a fixed keyframe does not move. The landmark budget (max_ba_landmarks) still
+// counts them, so the BA keeps the landmarks it had.
+void LocalMapper::excludeSingleViewLandmarks() {
+  KeyframeMask window_mask = 0, ba_mask = 0;
+  for (int slot : s_->window) window_mask |= KeyframeMask(1) << slot;
+  ba_mask = window_mask;
+  for (int slot : s_->fixed) ba_mask |= KeyframeMask(1) << slot;
+  auto single_view = [ba_mask](KeyframeMask observers) {
+    const KeyframeMask seen = observers & ba_mask;
+    return (seen & (seen - 1)) == 0;  // at most one bit
+  };
+  s_->single_view_points.clear();
+  std::size_t kept = 0;
+  for (uint32_t p : s_->ba_points) {
+    const KeyframeMask observers = map_.point(int(p)).observers.mask;
+    if (!single_view(observers)) {
+      s_->ba_points[kept++] = p;
+      continue;
+    }
+    s_->point_stamp[p] = 0;  // no BA observation (stamps start at 1)
+    if (observers & window_mask) (void)s_->single_view_points.push_back(p);
+  }
+  s_->ba_points.resize(kept);
+  s_->single_view_lines.clear();
+  kept = 0;
+  for (uint32_t l : s_->ba_lines) {
+    const KeyframeMask observers = map_.line(int(l)).observers.mask;
+    if (!single_view(observers)) {
+      s_->ba_lines[kept++] = l;
+      continue;
+    }
+    s_->line_stamp[l] = 0;
+    if (observers & window_mask) (void)s_->single_view_lines.push_back(l);
+  }
+  s_->ba_lines.resize(kept);
+}
+
+// After the window's poses were written back (ba_correction holds each window keyframe's
+// T_world_cam new * old^-1): the single-view landmarks follow their keyframe.
+void LocalMapper::moveSingleViewLandmarks() {
+  KeyframeMask window_mask = 0;
+  for (int slot : s_->window) window_mask |= KeyframeMask(1) << slot;
+  auto correction_of = [&](KeyframeMask observers) -> const Eigen::Isometry3d& {
+    return s_->ba_correction[std::size_t(__builtin_ctz(observers & window_mask))];
+  };
+  for (uint32_t p : s_->single_view_points) {
+    MapPoint& point = map_.point(int(p));
+    point.P_world = correction_of(point.observers.mask) * point.P_world;
+  }
+  for (uint32_t l : s_->single_view_lines) {
+    MapLine& line = map_.line(int(l));
+    const Eigen::Isometry3d& correction = correction_of(line.observers.mask);
+    for (int s = 0; s < line.num_samples; ++s) line.samples_world[s] = correction * line.samples_world[s];
+    line.start_world = correction * line.start_world;
+    line.end_world = correction * line.end_world;
+  }
+}
+
 void LocalMapper::runLocalBa(int kf_slot, InsertResult* result) {
   selectWindow(kf_slot);
   auto& window = s_->window;
@@ -92,6 +158,8 @@ void LocalMapper::runLocalBa(int kf_slot, InsertResult* result) {
     (void)fixed.push_back(*oldest);
     window.resize(std::size_t(std::remove(window.begin(), window.end(), *oldest) - window.begin()));
   }
+
+  excludeSingleViewLandmarks();
 
   ba_.clear();
   s_->ba_keyframe_index.fill(-1);
@@ -142,19 +210,30 @@ void LocalMapper::runLocalBa(int kf_slot, InsertResult* result) {
   ++stats_.ba_runs;
   result->ba_initial_cost = summary.initial_cost;
   result->ba_final_cost = summary.final_cost;
-  if (!summary.ok()) return;
+  if (!summary.ok()) {
+    writeUncertainty(kf_slot, false, 1.0);
+    return;
+  }
 
   // Write back poses, landmarks, covariances.
+  const double variance_factor = ba_.varianceFactor(ba_options_);  // before: the covariance re-evaluates chi2
   const bool have_covariance = ba_.computeCovariance(ba_options_);
   for (int slot : window) {
     Keyframe& kf = map_.keyframe(slot);
     const int index = s_->ba_keyframe_index[slot];
-    kf.T_world_cam = ba_.pose(index).inverse();
+    const Eigen::Isometry3d T_world_cam = ba_.pose(index).inverse();
+    s_->ba_correction[std::size_t(slot)] = T_world_cam * kf.T_world_cam.inverse();
+    kf.T_world_cam = T_world_cam;
     if (have_covariance) {
-      kf.covariance = ba_.covariance(index);
+      // Calibrated like the relative covariances (docs/UNCERTAINTY.md); its gauge is this BA's
+      // fixed keyframes.
+      const UncertaintyOptions& u = options_.uncertainty;
+      kf.covariance = (u.use_variance_factor ? variance_factor : 1.0) * u.relative_scale * ba_.covariance(index);
       kf.covariance_valid = true;
     }
   }
+  moveSingleViewLandmarks();
+  writeUncertainty(kf_slot, have_covariance, variance_factor);
   for (uint32_t p : s_->ba_points) map_.point(int(p)).P_world = ba_.landmark(s_->point_ba_index[p]);
   for (uint32_t l : s_->ba_lines) {
     MapLine& line = map_.line(int(l));

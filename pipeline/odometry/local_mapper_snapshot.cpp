@@ -10,10 +10,14 @@ void LocalMapper::publishSnapshot(int kf_slot) {
   out.clear();
   out.version = ++snapshot_version_;
   out.segment = segment_;
+  out.loop_corrections = loop_corrections_;
+  out.T_loop_corrections = T_loop_corrections_;
   const Keyframe& reference = map_.keyframe(kf_slot);
   out.reference_keyframe_id = reference.id;
   out.reference_keyframe_sequence = reference.frame_sequence;
   out.T_world_reference = reference.T_world_cam;
+  out.reference_world_covariance = reference.uncertainty.world_covariance;
+  out.reference_world_covariance_valid = reference.uncertainty.world_covariance_valid;
 
   // Every keyframe of the map, by id (the system resolves reference-relative frame poses).
   FixedVector<std::pair<uint32_t, int>, kMaxMapKeyframes> by_id;

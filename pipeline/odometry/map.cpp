@@ -53,6 +53,7 @@ int Map::addKeyframe() {
     kf.lines.clear();
     kf.covariance.setZero();
     kf.covariance_valid = false;
+    kf.uncertainty = KeyframeUncertainty{};
     return int(i);
   }
   return -1;

@@ -13,6 +13,10 @@ namespace plumb {
 struct MapCorrection {
   uint32_t keyframe_id = 0;
   Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
+  // The loop that caused it: the old keyframe the query keyframe was matched to, at its optimised
+  // pose (0: none). Only viewers read it (the loop edge they draw); the mapping side ignores it.
+  uint32_t loop_candidate_id = 0;
+  Eigen::Isometry3d T_world_candidate = Eigen::Isometry3d::Identity();
 };
 
 }  // namespace plumb

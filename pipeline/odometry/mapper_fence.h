@@ -1,19 +1,20 @@
 #pragma once
 // MapperFence: how the tracking side waits for the mapping side in a threaded run.
 //
-// Starting a map (segment) and relocalizing need the mapper and the relocalizer synchronously, and
-// those belong to the mapping thread. Before either, the tracking thread calls waitForMapper(),
-// which returns once every frame tracked before the current one has been through mapFrame(): the
-// mapping thread is then idle until the current frame reaches it, so the two threads never touch
-// the mapper or the relocalizer at the same time. In lock-step (`threaded` false) that is always
-// already true and the fence never waits.
+// Relocalizing reads the relocalizer, which the mapping thread writes. Before it, the tracking
+// thread calls waitForMapper(), which returns once every frame tracked before the current one has
+// been through the map stage: the mapping thread is then idle until the current frame reaches it,
+// so the two threads never use the relocalizer at the same time. waitUntilMapped(n) waits for the
+// first n frames only: the fixed lag of map updates waits there for the frame whose update is due
+// (OdometrySystem::syncWithMapping), a frame that asked for a new map for that frame. In lock-step
+// (`threaded` false) that is always already true and the fence never waits.
 //
-// It also carries the staleness bound of a threaded run, `max_frames_ahead`: how many frames the
-// tracker may track past a keyframe it asked for before it waits for the map stage to publish it
-// (OdometrySystem::trackFeatures). 0 = never: every keyframe decision and every frame is tracked
-// against exactly the map lock-step would have (fast mode: the deterministic bytes). The runner
-// chooses it per mode (pipeline/run/odometry_run.h, docs/RUNTIME.md "When the map stage falls
-// behind").
+// It also carries how a run tracks against the map stage's updates, `max_frames_ahead`: 0 (the
+// deterministic and fast schedules): at the fixed lag (SystemOptions::map_lag_frames), the same
+// map in every schedule, so fast mode writes the deterministic bytes; > 0 (realtime): the newest
+// snapshot, with at most that many frames tracked past a keyframe the tracker asked for before it
+// waits for it. The runner chooses it per mode (pipeline/run/run_session.cpp, docs/RUNTIME.md
+// "When the map stage falls behind").
 #include <atomic>
 #include <cstdint>
 
@@ -30,12 +31,16 @@ class MapperFence {
   int maxFramesAhead() const { return max_frames_ahead_; }
 
   // Tracking thread: while frame number framesTracked() is being tracked.
-  void waitForMapper() {
-    if (!threaded_) return;
-    bell_.waitUntil([this] {
-      return failed_.load(std::memory_order_acquire) ||
-             frames_mapped_.load(std::memory_order_acquire) >= frames_tracked_;
-    });
+  void waitForMapper() { (void)waitUntilMapped(frames_tracked_); }
+  // Tracking thread: returns once the first `frames` frames have been through the map stage (or
+  // it failed); true when that meant waiting.
+  bool waitUntilMapped(uint64_t frames) {
+    auto done = [this, frames] {
+      return failed_.load(std::memory_order_acquire) || frames_mapped_.load(std::memory_order_acquire) >= frames;
+    };
+    if (!threaded_ || done()) return false;
+    bell_.waitUntil(done);
+    return true;
   }
   // Tracking thread: after each frame.
   void frameTracked() { ++frames_tracked_; }

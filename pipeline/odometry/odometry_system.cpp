@@ -29,6 +29,11 @@ Status validate(const SystemOptions& options) {
                          ") exceeds line_samples (" + std::to_string(options.odometry.extractor.line_samples) +
                          "): no line could ever be fitted");
   }
+  if (options.map_lag_frames < 1 || options.map_lag_frames > SystemOptions::kMaxMapLagFrames) {
+    return Status::Error("map lag must be within 1.." + std::to_string(SystemOptions::kMaxMapLagFrames) + " frames");
+  }
+  const std::string uncertainty = validate(options.odometry.uncertainty);
+  if (!uncertainty.empty()) return Status::Error("uncertainty options: " + uncertainty);
   if (options.output_delay_frames < 0 || options.output_delay_frames >= OdometryTrajectory::kMaxDelayFrames) {
     return Status::Error("output delay must be within 0.." + std::to_string(OdometryTrajectory::kMaxDelayFrames - 1) +
                          " frames");
@@ -70,8 +75,15 @@ OdometrySystem::~OdometrySystem() = default;
 void OdometrySystem::installNewestSnapshot() {
   uint64_t version = 0;
   const LocalMap* snapshot = snapshots_->acquireLatest(&version);
-  // Older than what the tracker has: a map start installed a newer one directly (startMap).
-  if (snapshot != nullptr && snapshot->version > tracking_.tracker->localMap().version) tracking_.tracker->setLocalMap(*snapshot);
+  if (snapshot == nullptr || snapshot->version <= tracking_.tracker->localMap().version) return;
+  // The first snapshot after a new-map request is that map (the mapping side handles frames in
+  // order, and the request's frame has been mapped before the next one is tracked).
+  if (tracking_.new_map_requested) {
+    tracking_.tracker->adoptNewMap(*snapshot);
+    tracking_.new_map_requested = false;
+  } else {
+    tracking_.tracker->setLocalMap(*snapshot);
+  }
 }
 
 bool OdometrySystem::canStartMap(const FrameFeatures& features) const {
@@ -84,28 +96,73 @@ bool OdometrySystem::canStartMap(const FrameFeatures& features) const {
   return points >= needed || (points >= needed / 2 && lines >= options_.odometry.min_initial_lines);
 }
 
-// Synchronous with the mapper (after the fence): the next frame must be tracked against the new
-// map, and a map start is rare (first frame, relocalization failing for many frames).
-void OdometrySystem::startMap(const FrameFeatures& features, uint64_t sequence, double timestamp_s,
-                              const Eigen::Isometry3d& T_world_cam, MapperFence* fence, TrackedFrame* out) {
-  if (fence != nullptr) fence->waitForMapper();
-  KeyframeRequest& request = out->request;
-  tracking_.tracker->fillNewMapRequest(features, sequence, timestamp_s, T_world_cam, &request);
-  const InsertResult inserted = mapping_.mapper->insertKeyframe(request);
-  tracking_.tracker->setLocalMap(mapping_.mapper->localMap());
+// The schedule's part of tracking a frame: which map it is tracked against, and whether a keyframe
+// request is still pending (no keyframe decision then).
+//
+// Fixed lag (deterministic and fast, fence->maxFramesAhead() == 0): the update a request of frame k
+// asked for is installed when frame k + map_lag_frames is tracked, never earlier or later. A
+// threaded run waits there until the map stage has finished frame k completely (keyframe, local
+// BA, loop closing and its correction); lock-step has finished it already. Nothing else changes the
+// map in between (no keyframe decision while a request is pending; in these schedules the loop
+// stage runs on the map stage's thread, right after the keyframe), so every frame is tracked
+// against the same map in both schedules: the same bytes, however the threads are timed.
+bool OdometrySystem::syncWithMapping(MapperFence* fence) {
+  const uint64_t frame = tracking_.frames++;
+  if (fence != nullptr && fence->maxFramesAhead() > 0) return syncWithNewestSnapshot(*fence);
+  if (!tracking_.update_pending) return false;
+  if (frame < tracking_.update_due) return true;
+  if (fence != nullptr && fence->waitUntilMapped(tracking_.update_frame + 1)) ++tracking_.mapper_waits;
+  installNewestSnapshot();
+  tracking_.update_pending = false;
+  return false;
+}
+
+// Real time (fence->maxFramesAhead() > 0): the newest snapshot published so far, with bounded
+// staleness on a starved CPU: the tracker runs at most maxFramesAhead() frames past a keyframe it
+// asked for before it waits for the mapper to publish it. Without the bound, a lagging map stage
+// leaves tracking on an ever older map (no new keyframes while one is pending) and accuracy
+// collapses under load. A new map is waited for before the next frame.
+bool OdometrySystem::syncWithNewestSnapshot(MapperFence& fence) {
+  // Read before installing: a request reported done has its snapshot published already.
+  bool request_pending = keyframe_requests_done_.load(std::memory_order_acquire) < tracking_.keyframe_requests;
+  if (tracking_.new_map_requested) {
+    if (fence.waitUntilMapped(tracking_.frames - 1)) ++tracking_.mapper_waits;
+    request_pending = false;
+  } else if (request_pending && fence.threaded() && ++tracking_.frames_since_request > fence.maxFramesAhead()) {
+    fence.waitForMapper();
+    ++tracking_.mapper_waits;
+    request_pending = keyframe_requests_done_.load(std::memory_order_acquire) < tracking_.keyframe_requests;
+  }
+  if (!request_pending) tracking_.frames_since_request = 0;
+  installNewestSnapshot();
+  return request_pending;
+}
+
+// The frame being tracked asked the mapping side for a map update (a keyframe or a new map).
+void OdometrySystem::expectMapUpdate(int lag_frames) {
+  ++tracking_.keyframe_requests;
+  tracking_.update_pending = true;
+  tracking_.update_frame = tracking_.frames - 1;
+  tracking_.update_due = tracking_.update_frame + uint64_t(lag_frames);
+}
+
+// The mapping side builds the map from the request (mapFrame), in frame order; the tracker
+// restarts from this frame now and adopts the new map with the next frame's snapshot.
+void OdometrySystem::requestNewMap(const FrameFeatures& features, uint64_t sequence, double timestamp_s,
+                                   const Eigen::Isometry3d& T_world_cam, TrackedFrame* out) {
+  tracking_.tracker->fillNewMapRequest(features, sequence, timestamp_s, T_world_cam, &out->request);
   tracking_.tracker->resetAt(features, T_world_cam);
-  relocalizer_->addKeyframe(inserted.keyframe_id, T_world_cam, features);
-  tracking_.map_started = true;
-  tracking_.lost = false;
+  tracking_.phase = TrackingPhase::kTrack;
   tracking_.lost_streak = 0;
+  tracking_.new_map_requested = true;
+  out->map_keyframe = true;
+  expectMapUpdate(1);
   FrameOutput& o = out->output;
   o.state = TrackingState::kOk;
   o.has_pose = true;
   o.T_world_cam = T_world_cam;
   o.keyframe = true;
   o.new_map = true;
-  o.insert = inserted;
-  out->reference_id = inserted.keyframe_id;
 }
 
 // The relocalizer's keyframes are written by the mapping side: wait until it is idle.
@@ -116,13 +173,24 @@ void OdometrySystem::tryRelocalize(const FrameFeatures& features, MapperFence* f
   const RelocResult r = relocalizer_->relocalize(features, &T_world_cam);
   if (!r.success) return;
   tracking_.tracker->resetAt(features, T_world_cam);
-  tracking_.lost = false;
+  tracking_.phase = TrackingPhase::kTrack;
   tracking_.lost_streak = 0;
   FrameOutput& o = out->output;
   o.state = TrackingState::kOk;
   o.has_pose = true;
   o.T_world_cam = T_world_cam;
   o.relocalized = true;
+}
+
+void OdometrySystem::relocalizeOrStartSegment(const FrameFeatures& features, uint64_t sequence, double timestamp_s,
+                                              MapperFence* fence, TrackedFrame* out) {
+  tryRelocalize(features, fence, out);
+  if (!out->output.has_pose &&
+      ++tracking_.lost_streak >= options_.odometry.relocalizer.max_lost_frames_before_new_map &&
+      canStartMap(features)) {
+    // Relocalization keeps failing: a new map segment from here, at the last known pose.
+    requestNewMap(features, sequence, timestamp_s, tracking_.T_world_last_good, out);
+  }
 }
 
 void OdometrySystem::addLoadedKeyframe(uint32_t keyframe_id, const Eigen::Isometry3d& T_world_cam, std::size_t n,
@@ -133,55 +201,53 @@ void OdometrySystem::addLoadedKeyframe(uint32_t keyframe_id, const Eigen::Isomet
 
 void OdometrySystem::beginInLoadedMap(uint32_t first_new_id) {
   mapping_.mapper->setNextKeyframeId(first_new_id);
-  tracking_.map_started = true;
-  tracking_.lost = true;
-  tracking_.awaiting_loaded_map = true;
+  tracking_.phase = TrackingPhase::kRelocalizeIntoLoadedMap;
   tracking_.lost_streak = 0;
 }
 
-// The relocalized pose is in the loaded map's frame; the local map is empty, so it starts here (a
-// new map segment at that pose) instead of Tracker::resetAt against a map that has no landmarks.
-void OdometrySystem::tryRelocalizeIntoLoadedMap(const FrameFeatures& features, uint64_t sequence, double timestamp_s,
-                                                MapperFence* fence, TrackedFrame* out) {
+// The relocalized pose is in the loaded map's frame; the local map is empty, so a map starts here
+// (a new map segment at that pose) instead of Tracker::resetAt against a map without landmarks.
+void OdometrySystem::relocalizeIntoLoadedMap(const FrameFeatures& features, uint64_t sequence, double timestamp_s,
+                                             MapperFence* fence, TrackedFrame* out) {
   if (fence != nullptr) fence->waitForMapper();
   out->relocalization_attempted = true;
   Eigen::Isometry3d T_world_cam;
   const RelocResult r = relocalizer_->relocalize(features, &T_world_cam);
   if (!r.success || !canStartMap(features)) return;
-  startMap(features, sequence, timestamp_s, T_world_cam, fence, out);
-  tracking_.awaiting_loaded_map = false;
+  requestNewMap(features, sequence, timestamp_s, T_world_cam, out);
   out->output.relocalized = true;
+}
+
+void OdometrySystem::trackAgainstMap(const FrameFeatures& features, uint64_t sequence, double timestamp_s,
+                                     bool request_pending, MapperFence* fence, TrackedFrame* out) {
+  FrameOutput& o = out->output;
+  o.track = tracking_.tracker->track(features, sequence, timestamp_s, request_pending ? nullptr : &out->request);
+  o.state = o.track.state;
+  if (o.state == TrackingState::kLost) {
+    tracking_.phase = TrackingPhase::kRelocalize;
+    tracking_.lost_streak = 1;
+    tryRelocalize(features, fence, out);
+    return;
+  }
+  o.has_pose = true;
+  o.T_world_cam = o.track.T_world_cam;
+  const LocalMap& snapshot = tracking_.tracker->localMap();
+  out->reference_id = snapshot.reference_keyframe_id;
+  out->T_ref_cam = snapshot.T_world_reference.inverse() * o.T_world_cam;
+  out->map_keyframe = o.track.keyframe_requested;
+  if (out->map_keyframe) expectMapUpdate(options_.map_lag_frames);
 }
 
 void OdometrySystem::trackFeatures(const FrameFeatures& features, uint64_t sequence, double timestamp_s,
                                    MapperFence* fence, TrackedFrame* out) {
   const auto start = std::chrono::steady_clock::now();
-  // Read before installing: a request reported done has its snapshot published already.
-  bool request_pending = keyframe_requests_done_.load(std::memory_order_acquire) < tracking_.keyframe_requests;
-  // Bounded staleness (threaded runs on a starved CPU): the tracker runs at most
-  // fence->maxFramesAhead() frames past a keyframe it asked for before it waits for the mapper to
-  // publish it (0 in fast mode: never, so it tracks against lock-step's map). Without the bound, a
-  // lagging map stage leaves tracking on an ever older map (no new keyframes while one is pending)
-  // and accuracy collapses under load. In lock-step a request is always done before the next
-  // frame, so this never waits there.
-  if (fence != nullptr && fence->threaded() && fence->maxFramesAhead() == 0) {
-    // Lock-step's map: a frame that asked for a keyframe is mapped completely (the keyframe, local
-    // BA and whatever loop closing did with it) before the next one is tracked. "Not pending" is
-    // not enough: the mapper reports the request done before its loop correction is applied.
-    if (tracking_.keyframe_requests > tracking_.keyframe_requests_synced) {
-      fence->waitForMapper();
-      ++tracking_.mapper_waits;
-      tracking_.keyframe_requests_synced = tracking_.keyframe_requests;
-      request_pending = false;
-    }
-  } else if (request_pending && fence != nullptr && fence->threaded() &&
-             ++tracking_.frames_since_request > fence->maxFramesAhead()) {
-    fence->waitForMapper();
-    ++tracking_.mapper_waits;
-    request_pending = keyframe_requests_done_.load(std::memory_order_acquire) < tracking_.keyframe_requests;
+  const bool request_pending = syncWithMapping(fence);
+  const LocalMap& installed = tracking_.tracker->localMap();
+  if (installed.loop_corrections != tracking_.loop_corrections_seen) {
+    // A new segment restarts the count at 0 (and is announced as a new map); only an increase is a jump.
+    tracking_.loop_correction_unannounced |= installed.loop_corrections > tracking_.loop_corrections_seen;
+    tracking_.loop_corrections_seen = installed.loop_corrections;
   }
-  if (!request_pending) tracking_.frames_since_request = 0;
-  installNewestSnapshot();
   FrameOutput& o = out->output;
   o = FrameOutput{};
   o.sequence = sequence;
@@ -191,36 +257,27 @@ void OdometrySystem::trackFeatures(const FrameFeatures& features, uint64_t seque
   out->map_keyframe = false;
   out->relocalization_attempted = false;
 
-  if (!tracking_.map_started) {
-    if (canStartMap(features)) startMap(features, sequence, timestamp_s, tracking_.T_world_last_good, fence, out);
-  } else if (tracking_.awaiting_loaded_map) {
-    tryRelocalizeIntoLoadedMap(features, sequence, timestamp_s, fence, out);
-  } else if (tracking_.lost) {
-    tryRelocalize(features, fence, out);
-    if (!o.has_pose && ++tracking_.lost_streak >= options_.odometry.relocalizer.max_lost_frames_before_new_map &&
-        canStartMap(features)) {
-      // Relocalization keeps failing: a new map segment from here, at the last known pose.
-      startMap(features, sequence, timestamp_s, tracking_.T_world_last_good, fence, out);
-    }
-  } else {
-    o.track = tracking_.tracker->track(features, sequence, timestamp_s, request_pending ? nullptr : &out->request);
-    o.state = o.track.state;
-    if (o.state == TrackingState::kLost) {
-      tracking_.lost = true;
-      tracking_.lost_streak = 1;
-      tryRelocalize(features, fence, out);
-    } else {
-      o.has_pose = true;
-      o.T_world_cam = o.track.T_world_cam;
-      const LocalMap& snapshot = tracking_.tracker->localMap();
-      out->reference_id = snapshot.reference_keyframe_id;
-      out->T_ref_cam = snapshot.T_world_reference.inverse() * o.T_world_cam;
-      out->map_keyframe = o.track.keyframe_requested;
-      tracking_.keyframe_requests += out->map_keyframe;
-    }
+  switch (tracking_.phase) {
+    case TrackingPhase::kStartMap:
+      if (canStartMap(features)) requestNewMap(features, sequence, timestamp_s, tracking_.T_world_last_good, out);
+      break;
+    case TrackingPhase::kRelocalizeIntoLoadedMap:
+      relocalizeIntoLoadedMap(features, sequence, timestamp_s, fence, out);
+      break;
+    case TrackingPhase::kRelocalize:
+      relocalizeOrStartSegment(features, sequence, timestamp_s, fence, out);
+      break;
+    case TrackingPhase::kTrack:
+      trackAgainstMap(features, sequence, timestamp_s, request_pending, fence, out);
+      break;
   }
-  if (!o.has_pose && tracking_.map_started) o.state = TrackingState::kLost;
+  // Once a map exists (or a loaded one is awaited) a frame without a pose is lost.
+  if (!o.has_pose && tracking_.phase != TrackingPhase::kStartMap) o.state = TrackingState::kLost;
   if (o.has_pose) tracking_.T_world_last_good = o.T_world_cam;
+  if (o.has_pose && tracking_.loop_correction_unannounced) {
+    o.loop_corrected = true;
+    tracking_.loop_correction_unannounced = false;
+  }
   o.track_ms = millisecondsSince(start);
 }
 
@@ -251,6 +308,9 @@ bool OdometrySystem::applyLoopCorrection() {
     return false;
   }
   ++mapping_.stats.loop_corrections_applied;
+  mapping_.last_correction = *correction;
+  if (mapping_.applied_corrections.size() < kMaxRecordedCorrections)
+    mapping_.applied_corrections.push_back(mapping_.mapper->lastCorrection());
   const LocalMap& snapshot = mapping_.mapper->localMap();
   snapshots_->writeBuffer() = snapshot;
   snapshots_->publish(snapshot.version);
@@ -275,6 +335,9 @@ const FrameOutput& OdometrySystem::mapFrame(const TrackedFrame& tracked) {
     }
   }
   recordOutput(tracked);
+  const LocalMap& world = mapping_.mapper->localMap();
+  mapping_.trajectory.setWorld(mapping_.stats.loop_corrections_applied, world.segment, world.loop_corrections,
+                               world.T_loop_corrections);
   mapping_.stats.output_overflows += !mapping_.trajectory.push(mapping_.output.sequence, mapping_.output.timestamp_s, mapping_.output.has_pose, mapping_.output.T_world_cam, reference_id,
                    T_ref_cam);
   return mapping_.output;

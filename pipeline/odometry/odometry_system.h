@@ -1,31 +1,39 @@
 #pragma once
 // OdometrySystem: the odometry as two sides that run on the track and map stages of the one runner
-// (pipeline/run/odometry_run.h); extraction is the extract stage's own FeatureExtractor.
+// (pipeline/run/run_session.h); extraction is the extract stage's own FeatureExtractor.
 //
 //   trackFeatures (tracking side): installs the newest LocalMap snapshot the mapping side published
-//     (runtime::LatestSnapshot, newer versions only), tracks, and fills a TrackedFrame (pose,
-//     reference keyframe, keyframe request) that travels with the frame to
-//   mapFrame (mapping side, frame order): LocalMapper::insertKeyframe + local BA for a request,
-//     publishes the new snapshot, updates the relocalizer, statistics and the output trajectory.
+//     (runtime::LatestSnapshot, newer versions only), then one step of a four-phase state machine
+//     (TrackingPhase: start a map / relocalize into a loaded map / relocalize when lost / track)
+//     and fills a TrackedFrame (pose, reference keyframe, keyframe request) that travels with the
+//     frame to
+//   mapFrame (mapping side, frame order): LocalMapper::insertKeyframe + local BA for a request (a
+//     new map or segment too: the tracking side only asks for it), publishes the new snapshot,
+//     updates the relocalizer, statistics and the output trajectory.
 //   lost -> Relocalizer (stored keyframes) -> Tracker::resetAt; still lost after M frames -> a new
-//   map segment starts from the current frame at the last known pose (the trajectory continues).
+//   map segment is requested from the current frame at the last known pose (the trajectory
+//   continues).
 //
-// Each side's state is its own struct (TrackingSide, MappingSide) and nothing here hands one side's
-// state to the other's thread. What they share: the snapshot channel (mapping -> tracking), a
-// counter of finished keyframe requests, and the relocalizer, which only the rare synchronous
-// events touch from the tracking side: starting a map (segment) and relocalizing wait on the
-// MapperFence (pipeline/odometry/mapper_fence.h) until every earlier frame has been mapped, so the
-// two threads never use the mapper or the relocalizer at the same time. In lock-step the fence
-// never waits and every frame sees exactly the single-threaded map. Threaded runs track against
-// the newest snapshot published so far, at most fence->maxFramesAhead() frames past a keyframe
-// they asked for (fast mode: 0, so they too see exactly the lock-step map), and while a keyframe
-// request is still with the mapper the tracker makes no keyframe decision (ORB-SLAM's "local
-// mapping busy"): it would judge against a map that lacks the pending keyframe.
+// Each side's state is its own struct (TrackingSide, MappingSide) and only the mapping side calls
+// the mapper. What the sides share: the snapshot channel (mapping -> tracking), a counter of
+// finished keyframe requests, and the relocalizer, which the mapping side writes and the tracking
+// side reads only to relocalize, after MapperFence::waitForMapper() (pipeline/odometry/
+// mapper_fence.h) has seen every earlier frame mapped, so the two threads never use it at the same
+// time.
+// Which map a frame is tracked against (syncWithMapping): in the deterministic and fast schedules
+// the map update a keyframe request of frame k asked for is used from frame k +
+// SystemOptions::map_lag_frames on (a new map: from k + 1), the fast schedule waiting there for the
+// map stage if it is behind, so both schedules track every frame against the same map and write the
+// same bytes. Real time tracks against the newest snapshot published so far, at most
+// fence->maxFramesAhead() frames past a keyframe it asked for. While a keyframe request is pending
+// the tracker makes no keyframe decision (ORB-SLAM's "local mapping busy"): it would judge against
+// a map that lacks the pending keyframe.
 // Output: finished frames (reference-keyframe relative, see OdometryTrajectory) and retired
 // keyframes with their covariance, drained on the mapping side.
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "sensor/camera.h"
 #include "pipeline/frontend/frame_features.h"
@@ -52,10 +60,14 @@ struct FrameOutput {
   bool keyframe = false;
   bool relocalized = false;
   bool new_map = false;
+  // The pose is the first after a loop correction moved the map (docs/LOOP.md "What the robot
+  // receives"): the trajectory jumps here, MAVLink announces it with reset_counter.
+  bool loop_corrected = false;
   bool dropped = false;  // mapDroppedFrame(): the runtime dropped this frame, nothing else is set
   TrackResult track;
   InsertResult insert;
   double extract_ms = 0, track_ms = 0, map_ms = 0;
+  double register_ms = 0;   // depth registration (unregistered depth cameras only; 0 otherwise)
   int64_t t_sensor_ns = 0;  // host monotonic time the frame was captured (set by the runner)
 };
 
@@ -74,6 +86,18 @@ struct SystemOptions {
   OdometryOptions odometry;
   // Output delay of the reference-keyframe-relative trajectory (frames); 0 = poses as tracked.
   int output_delay_frames = 60;
+  // Map updates reach tracking at a fixed lag (docs/RUNTIME.md "Map updates at a fixed lag"): the
+  // LocalMap snapshot the mapping side makes from frame k's keyframe request is tracked against
+  // from frame k + map_lag_frames on, in the deterministic and fast schedules alike, so both write
+  // the same bytes; until then the request is pending and the tracker makes no keyframe decision.
+  // 1 (default) = from the next frame: fast mode then waits for each keyframe's mapping before
+  // the next frame. L > 1 lets it track L - 1 frames meanwhile, but costs accuracy (low texture
+  // with noise: ATE 3.3x at L = 3; docs/RUNTIME.md "Map updates at a fixed lag"). A new map (first
+  // frame, new segment) is used from the next frame on whatever the lag. Real-time mode tracks on
+  // the newest snapshot instead (OdometryRunOptions::max_frames_ahead_of_mapper).
+  int map_lag_frames = kDefaultMapLagFrames;
+  static constexpr int kDefaultMapLagFrames = 1;
+  static constexpr int kMaxMapLagFrames = 16;
 };
 
 // Every option of the system in one place; validated once, where the system is built.
@@ -111,27 +135,37 @@ class OdometrySystem {
   // A frame the runtime dropped (real-time replay, no free slot) takes its place in the output
   // trajectory (FinishedFrame::dropped); call in frame order between mapFrame() calls.
   const FrameOutput& mapDroppedFrame(uint64_t sequence, double timestamp_s);
-  // Frames whose output pose is final, oldest first; fn(const FinishedFrame&).
+  // Frames whose output pose is final, oldest first; fn(const FinishedFrame&). end_of_run: every
+  // frame still held back for refinement is final now (resolved against the map as it is).
   template <typename Fn>
-  void drainFinishedFrames(Fn fn) { mapping_.trajectory.popReady(mapping_.mapper->localMap(), fn); }
+  void drainFinishedFrames(Fn fn, bool end_of_run = false) {
+    if (end_of_run) {
+      mapping_.trajectory.flushAll(mapping_.mapper->localMap(), fn);
+    } else {
+      mapping_.trajectory.popReady(mapping_.mapper->localMap(), fn);
+    }
+  }
+  // End of the run, after the last drainFinishedFrames(fn, true): every keyframe leaves the map.
+  void retireAllKeyframes() { mapping_.mapper->retireAll(); }
   // Retired keyframes (final pose + covariance); fn(const RetiredKeyframe&).
   template <typename Fn>
   void drainRetiredKeyframes(Fn fn) {
     for (const auto& kf : mapping_.mapper->retired()) fn(kf);
     mapping_.mapper->clearRetired();
   }
-  // End of the run: every pending frame is finished and every keyframe retired.
-  template <typename FrameFn, typename KeyframeFn>
-  void finish(FrameFn frame_fn, KeyframeFn keyframe_fn) {
-    mapping_.trajectory.flushAll(mapping_.mapper->localMap(), frame_fn);
-    mapping_.mapper->retireAll();
-    drainRetiredKeyframes(keyframe_fn);
-  }
   // Loop closing's corrections reach the mapping side through this channel (writer: the loop
   // stage; reader: the mapping side). mapFrame() applies the newest unapplied one before anything
   // else (docs/LOOP.md "Correction"); applyLoopCorrection() does the same at the end of a run.
   runtime::LatestSnapshot<MapCorrection>& loopCorrections() { return *corrections_; }
   bool applyLoopCorrection();
+  // Mapping side: the newest correction applyLoopCorrection() applied (a copy; keyframe_id 0
+  // before the first). Viewers draw loop edges from it.
+  const MapCorrection& lastLoopCorrection() const { return mapping_.last_correction; }
+  // The rigid motion each applied correction moved the map by, in order: entry e - 1 takes loop
+  // epoch e - 1 to epoch e (FinishedFrame::loop_epoch). The first kMaxRecordedCorrections are kept
+  // (reserved at construction); later ones are counted in stats only.
+  static constexpr std::size_t kMaxRecordedCorrections = 512;
+  const std::vector<Eigen::Isometry3d>& appliedCorrections() const { return mapping_.applied_corrections; }
   // The mapper, read by the mapping side's own thread (loop records).
   const LocalMapper& mapper() const { return *mapping_.mapper; }
   const OdometryStats& stats() const { return mapping_.stats; }
@@ -143,18 +177,30 @@ class OdometrySystem {
  private:
   OdometrySystem(const PinholeCamera& camera, const SystemOptions& options);
 
+  // What the tracking side does with the next frame.
+  enum class TrackingPhase : uint8_t {
+    kStartMap,                 // no map yet: the first frame with enough depth asks for one
+    kRelocalizeIntoLoadedMap,  // beginInLoadedMap(): relocalize against the loaded keyframes only
+    kRelocalize,               // lost: relocalize; after M failures ask for a new map segment
+    kTrack,                    // track against the local map snapshot
+  };
   // The tracking thread's state.
   struct TrackingSide {
     std::unique_ptr<Tracker> tracker;
-    bool map_started = false;
-    bool lost = false;
-    bool awaiting_loaded_map = false;  // beginInLoadedMap(): relocalize, never start a new map
+    TrackingPhase phase = TrackingPhase::kStartMap;
+    bool new_map_requested = false;  // the previous frame asked for a new map: adopt it next
     int lost_streak = 0;
     Eigen::Isometry3d T_world_last_good = Eigen::Isometry3d::Identity();
+    uint64_t frames = 0;             // frames tracked (during trackFeatures: the current one + 1)
+    // Fixed lag: the map update a keyframe request asked for, not in use yet.
+    bool update_pending = false;
+    uint64_t update_frame = 0;       // the frame (index) that asked for it
+    uint64_t update_due = 0;         // the first frame tracked against it
     uint64_t keyframe_requests = 0;  // handed to mapFrame()
     int frames_since_request = 0;    // frames tracked while the newest request was pending
-    uint64_t keyframe_requests_synced = 0;  // requests whose frame was fully mapped before tracking went on
     uint64_t mapper_waits = 0;       // times the bound above made tracking wait
+    uint64_t loop_corrections_seen = 0;  // of the map segment the tracker follows
+    bool loop_correction_unannounced = false;  // installed, no pose published since
   };
   // The mapping thread's state.
   struct MappingSide {
@@ -163,17 +209,29 @@ class OdometrySystem {
     OdometryStats stats;
     FrameOutput output;
     uint64_t correction_version = 0;  // newest loop correction seen (0: none)
-    explicit MappingSide(int delay_frames) : trajectory(delay_frames) {}
+    MapCorrection last_correction;    // newest one applied
+    std::vector<Eigen::Isometry3d> applied_corrections;  // appliedCorrections()
+    explicit MappingSide(int delay_frames) : trajectory(delay_frames) {
+      applied_corrections.reserve(kMaxRecordedCorrections);
+    }
   };
 
-  // Tracking side.
+  // Tracking side. syncWithMapping: the schedule's part (waits, the newest snapshot); returns
+  // whether a keyframe request is still with the mapper. The rest is the state machine.
+  bool syncWithMapping(MapperFence* fence);
+  bool syncWithNewestSnapshot(MapperFence& fence);
+  void expectMapUpdate(int lag_frames);
   void installNewestSnapshot();
   bool canStartMap(const FrameFeatures& features) const;
-  void startMap(const FrameFeatures& features, uint64_t sequence, double timestamp_s,
-                const Eigen::Isometry3d& T_world_cam, MapperFence* fence, TrackedFrame* out);
+  void requestNewMap(const FrameFeatures& features, uint64_t sequence, double timestamp_s,
+                     const Eigen::Isometry3d& T_world_cam, TrackedFrame* out);
+  void trackAgainstMap(const FrameFeatures& features, uint64_t sequence, double timestamp_s, bool request_pending,
+                       MapperFence* fence, TrackedFrame* out);
   void tryRelocalize(const FrameFeatures& features, MapperFence* fence, TrackedFrame* out);
-  void tryRelocalizeIntoLoadedMap(const FrameFeatures& features, uint64_t sequence, double timestamp_s,
-                                  MapperFence* fence, TrackedFrame* out);
+  void relocalizeOrStartSegment(const FrameFeatures& features, uint64_t sequence, double timestamp_s,
+                                MapperFence* fence, TrackedFrame* out);
+  void relocalizeIntoLoadedMap(const FrameFeatures& features, uint64_t sequence, double timestamp_s,
+                               MapperFence* fence, TrackedFrame* out);
   // Mapping side.
   void insertKeyframe(const KeyframeRequest& request);
   void recordOutput(const TrackedFrame& tracked);

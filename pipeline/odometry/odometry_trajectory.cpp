@@ -19,6 +19,8 @@ bool OdometryTrajectory::push(uint64_t sequence, double timestamp_s, bool valid,
   p.frame.T_world_cam = T_world_cam;
   p.reference_id = valid ? reference_id : 0;
   p.T_ref_cam = T_ref_cam;
+  p.world = world_;
+  p.frame.loop_epoch = world_.loop_epoch;
   return true;
 }
 
@@ -32,6 +34,10 @@ FinishedFrame OdometryTrajectory::resolve(const LocalMap& map, const Pending& p)
   for (const LocalMapKeyframe& kf : map.keyframes) {
     if (kf.id == p.reference_id) {
       out.T_world_cam = kf.T_world_cam * p.T_ref_cam;
+      // Corrected since the frame was queued: back into the world it was tracked in.
+      if (map.segment == p.world.segment && map.loop_corrections != p.world.corrections) {
+        out.T_world_cam = p.world.T_corrections * map.T_loop_corrections.inverse() * out.T_world_cam;
+      }
       break;
     }
   }

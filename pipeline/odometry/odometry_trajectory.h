@@ -28,6 +28,9 @@ struct FinishedFrame {
   // closing's optimised trajectory re-expresses the frame through that keyframe's final pose.
   uint32_t reference_id = 0;
   Eigen::Isometry3d T_ref_cam = Eigen::Isometry3d::Identity();
+  // Loop corrections the mapping side had applied when the frame was queued: the world frame
+  // T_world_cam is in (each correction moves the map; a frame keeps the world it was tracked in).
+  uint64_t loop_epoch = 0;
 };
 
 // The frame as a trajectory sample: what trajectory files, the tools and the API keep of it.
@@ -58,6 +61,14 @@ class OdometryTrajectory {
     return true;
   }
   bool full() const { return size_ >= kMaxDelayFrames; }
+  // The world the frames pushed from now on are in: `loop_epoch` loop corrections applied so far
+  // (all segments), and of the map segment `segment`, `corrections` of them composing to
+  // `T_corrections` (LocalMap::loop_corrections / T_loop_corrections). A frame is resolved in ITS
+  // world: a correction applied while it waits in the queue does not move it (it was tracked, and
+  // sent to the robot, before the correction; docs/LOOP.md "What the robot receives").
+  void setWorld(uint64_t loop_epoch, uint32_t segment, uint64_t corrections, const Eigen::Isometry3d& T_corrections) {
+    world_ = World{loop_epoch, segment, corrections, T_corrections};
+  }
   // Frames leaving the FIFO, resolved against the keyframe poses of `map`; calls fn(FinishedFrame)
   // for each. flushAll empties the FIFO (end of run).
   template <typename Fn>
@@ -66,10 +77,17 @@ class OdometryTrajectory {
   void flushAll(const LocalMap& map, Fn fn) { pop(map, true, fn); }
 
  private:
+  struct World {
+    uint64_t loop_epoch = 0;
+    uint32_t segment = 0;
+    uint64_t corrections = 0;
+    Eigen::Isometry3d T_corrections = Eigen::Isometry3d::Identity();
+  };
   struct Pending {
     FinishedFrame frame;
     uint32_t reference_id = 0;
     Eigen::Isometry3d T_ref_cam = Eigen::Isometry3d::Identity();
+    World world;
   };
   template <typename Fn>
   void pop(const LocalMap& map, bool all, Fn fn) {
@@ -83,6 +101,7 @@ class OdometryTrajectory {
   FinishedFrame resolve(const LocalMap& map, const Pending& p) const;
 
   int delay_;
+  World world_;
   std::array<Pending, kMaxDelayFrames> fifo_{};
   int head_ = 0;
   int size_ = 0;

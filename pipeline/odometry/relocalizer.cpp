@@ -6,8 +6,10 @@
 
 #include <Eigen/Geometry>
 
+#include "pipeline/frontend/descriptor_match.h"
 #include "solver/noise_model.h"
 #include "solver/pose_optimizer.h"
+#include "solver/rigid_fit.h"
 #include "solver/zero_page_allocator.h"
 
 namespace plumb {
@@ -19,6 +21,7 @@ struct Relocalizer::Scratch {
   FixedVector<Correspondence, kMaxKeypoints> correspondences;
   std::array<bool, kMaxKeypoints> inlier{};
   std::array<bool, kMaxKeypoints> best_inlier{};
+  std::array<Eigen::Vector3d, kMaxKeypoints> P_current, P_stored;  // the correspondences, for rigidRansac
   FixedVector<PosePointObservation, kMaxKeypoints> pose_points;
   std::array<bool, kMaxKeypoints> pose_inlier{};
 };
@@ -104,84 +107,33 @@ int Relocalizer::matchAll(const StoredKeyframe& kf, const FrameFeatures& frame) 
   for (std::size_t k = 0; k < frame.keypoints.size(); ++k) {
     if (frame.keypoints[k].depth_m <= 0) continue;
     const Descriptor256& d = frame.keypoint_descriptors[k];
-    int best = 256, second = 256, best_index = -1;
-    for (std::size_t j = 0; j < kf.descriptors.size(); ++j) {
-      const int dist = hammingDistance(d, kf.descriptors[j]);
-      if (dist < best) {
-        second = best;
-        best = dist;
-        best_index = int(j);
-      } else if (dist < second) {
-        second = dist;
-      }
-    }
-    if (best_index < 0 || best > o.hamming_threshold || float(best) >= o.ratio * float(second)) continue;
+    const int best_index =
+        bestRatioMatch(d, kf.descriptors.data(), kf.descriptors.size(), o.hamming_threshold, o.ratio);
+    if (best_index < 0) continue;
     (void)out.push_back(Correspondence{uint16_t(k), frame.keypoints[k].P_cam.cast<double>(),
                                        kf.P_cam[std::size_t(best_index)].cast<double>()});
   }
   return int(out.size());
 }
 
-namespace {
-
-// Rigid transform (no scale) mapping `from` onto `to`, least squares (Umeyama / Horn).
-Eigen::Isometry3d rigidFit(const Eigen::Matrix<double, 3, Eigen::Dynamic>& from,
-                           const Eigen::Matrix<double, 3, Eigen::Dynamic>& to) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.matrix() = Eigen::umeyama(from, to, false);
-  return T;
-}
-
-}  // namespace
-
-// RANSAC over minimal 3-point rigid fits. The inlier threshold grows with depth squared like the
-// sensor noise (inlier_threshold_m at 1 m).
+// RANSAC over minimal 3-point rigid fits, refitted on the inliers (solver/rigid_fit.h, shared with
+// loop verification). The inlier threshold grows with depth squared like the sensor noise
+// (inlier_threshold_m at 1 m).
 bool Relocalizer::ransac(Eigen::Isometry3d* T_stored_current, int* inliers) {
   const auto& c = s_->correspondences;
   const int n = int(c.size());
-  const RelocalizerOptions& o = options_.relocalizer;
-  std::mt19937 rng(uint32_t(o.seed));
-  std::uniform_int_distribution<int> pick(0, n - 1);
-  Eigen::Matrix3d from, to;
-  int best = 0;
-  auto count_inliers = [&](const Eigen::Isometry3d& T, std::array<bool, kMaxKeypoints>& flags) {
-    int count = 0;
-    for (int i = 0; i < n; ++i) {
-      const double depth = std::max(1.0, c[i].P_stored.z());
-      const double threshold = o.inlier_threshold_m * depth * depth;
-      flags[i] = (T * c[i].P_current - c[i].P_stored).squaredNorm() < threshold * threshold;
-      count += flags[i];
-    }
-    return count;
-  };
-  for (int it = 0; it < o.ransac_iterations; ++it) {
-    const int a = pick(rng), b = pick(rng), d = pick(rng);
-    if (a == b || a == d || b == d) continue;
-    from << c[a].P_current, c[b].P_current, c[d].P_current;
-    to << c[a].P_stored, c[b].P_stored, c[d].P_stored;
-    // Nearly collinear samples give an ill-defined rotation.
-    if ((to.col(1) - to.col(0)).cross(to.col(2) - to.col(0)).norm() < 1e-4) continue;
-    const Eigen::Isometry3d T = rigidFit(from, to);
-    const int count = count_inliers(T, s_->inlier);
-    if (count > best) {
-      best = count;
-      *T_stored_current = T;
-      s_->best_inlier = s_->inlier;
-    }
-  }
-  if (best < 3) return false;
-  // Refit on all inliers (dynamic matrices: only on the rare lost frames).
-  Eigen::Matrix<double, 3, Eigen::Dynamic> all_from(3, best), all_to(3, best);
-  int j = 0;
   for (int i = 0; i < n; ++i) {
-    if (!s_->best_inlier[i]) continue;
-    all_from.col(j) = c[i].P_current;
-    all_to.col(j) = c[i].P_stored;
-    ++j;
+    s_->P_current[std::size_t(i)] = c[i].P_current;
+    s_->P_stored[std::size_t(i)] = c[i].P_stored;
   }
-  *T_stored_current = rigidFit(all_from, all_to);
-  *inliers = count_inliers(*T_stored_current, s_->best_inlier);
-  return true;
+  const RelocalizerOptions& o = options_.relocalizer;
+  RigidRansacOptions ransac;
+  ransac.iterations = o.ransac_iterations;
+  ransac.inlier_threshold_m = o.inlier_threshold_m;
+  ransac.seed = uint32_t(o.seed);
+  *inliers = rigidRansac(s_->P_current.data(), s_->P_stored.data(), n, ransac, s_->inlier.data(),
+                         s_->best_inlier.data(), T_stored_current);
+  return *inliers >= 3;
 }
 
 int Relocalizer::refine(const FrameFeatures& frame, const StoredKeyframe& kf, Eigen::Isometry3d* T_cam_world) {

@@ -41,6 +41,7 @@ Tracker::Tracker(const PinholeCamera& camera, const OdometryOptions& options)
   pose_options_.chi2 = options.tracker.chi2;
   pose_options_.rounds = options.tracker.pose_rounds;
   pose_options_.iterations_per_round = options.tracker.pose_iterations_per_round;
+  pose_options_.step_tolerance = options.tracker.pose_step_tolerance;
   local_map_ = &b_->local_map;
   local_map_->clear();
 }
@@ -50,6 +51,9 @@ Tracker::~Tracker() = default;
 void Tracker::setLocalMap(const LocalMap& local_map) {
   // Corrections only make sense within one map segment (a new segment restarts with resetAt).
   const bool same_map = local_map_->version != 0 && local_map.segment == local_map_->segment;
+  if (has_last_frame_ && same_map && local_map.loop_corrections != local_map_->loop_corrections) {
+    followLoopCorrection(local_map.T_loop_corrections * local_map_->T_loop_corrections.inverse());
+  }
   *local_map_ = local_map;
   b_->point_visible.fill(0);
   b_->point_found.fill(0);
@@ -60,6 +64,12 @@ void Tracker::setLocalMap(const LocalMap& local_map) {
   for (auto& a : b_->last_points) a.local_index = -1;
   for (auto& a : b_->last_lines) a.local_index = -1;
   if (has_last_frame_ && same_map) followMapCorrections();
+}
+
+void Tracker::adoptNewMap(const LocalMap& local_map) {
+  setLocalMap(local_map);
+  last_reference_id_ = local_map_->reference_keyframe_id;
+  T_world_last_reference_ = local_map_->T_world_reference;
 }
 
 void Tracker::reset() {
@@ -126,11 +136,10 @@ TrackResult Tracker::track(const FrameFeatures& input, uint64_t sequence, double
 
   // 3. Local map: more matches, optimise again with everything.
   result.local_map_matches = matchLocalMap(frame, T_cam_world);
+  PoseResult final_pose;
   if (result.frame_matches + result.local_map_matches >= 6) {
-    const PoseResult pose = optimizeAndPrune(frame, T_cam_world, &result);
-    T_cam_world = pose.T_cam_world;
-    result.covariance = pose.covariance;
-    result.covariance_valid = pose.covariance_valid;
+    final_pose = optimizeAndPrune(frame, T_cam_world, &result);
+    T_cam_world = final_pose.T_cam_world;
   }
   const int inliers = result.point_inliers + result.line_inliers;
   if (inliers >= options_.tracker.min_inliers_ok) {
@@ -162,9 +171,12 @@ TrackResult Tracker::track(const FrameFeatures& input, uint64_t sequence, double
   velocity_cur_last_ = T_cam_world * T_world_last_;
   velocity_dt_s_ = timestamp_s - last_timestamp_s_;
   has_velocity_ = true;
+  const Vector6d twist_per_s = velocity_dt_s_ > 0 ? Vector6d(logSE3(velocity_cur_last_) / velocity_dt_s_) : Vector6d::Zero();
+  publishCovariance(final_pose, twist_per_s, &result);
   ++frames_since_keyframe_;
   if (request != nullptr && keyframeNeeded(frame, result)) {
     fillKeyframeRequest(frame, sequence, timestamp_s, T_world_cam, request);
+    request->twist_per_s = twist_per_s;
     result.keyframe_requested = true;
     frames_since_keyframe_ = 0;
   }
@@ -241,6 +253,7 @@ void Tracker::fillNewMapRequest(const FrameFeatures& frame, uint64_t sequence, d
   request->start_new_map = true;
   request->frame_sequence = sequence;
   request->timestamp_s = timestamp_s;
+  request->twist_per_s.setZero();
   request->T_world_cam = T_world_cam;
   request->local_map_version = 0;
   request->features = frame;

@@ -49,6 +49,10 @@ class Tracker {
   // reference keyframe (or becomes the keyframe's refined pose when it was made one), its depth
   // points move with it, and its landmark associations take the landmarks' refined positions.
   void setLocalMap(const LocalMap& local_map);
+  // The map this tracker asked for (KeyframeRequest::start_new_map) at its last frame, built by
+  // the mapping side: installed like setLocalMap, and the last frame, which is that map's first
+  // keyframe, takes it as its reference (as resetAt would have, had the map been there already).
+  void adoptNewMap(const LocalMap& local_map);
   const LocalMap& localMap() const { return *local_map_; }
 
   // Tracks one frame. When the result asks for a keyframe, `request` has been filled.
@@ -93,10 +97,16 @@ class Tracker {
   // tracker_pose.cpp: optimise from T_cam_world, drop outlier associations, count inliers.
   PoseResult optimizeAndPrune(const FrameFeatures& frame, const Eigen::Isometry3d& T_cam_world,
                               TrackResult* result);
+  // The tracked pose's published covariances (TrackResult) from the final optimisation.
+  // twist_per_s: the frame's velocity (timing model error, UncertaintyOptions).
+  void publishCovariance(const PoseResult& pose, const Vector6d& twist_per_s, TrackResult* result) const;
   // tracker.cpp
   void rememberLastFrame(const FrameFeatures& frame, const Eigen::Isometry3d& T_world_cam);
   // tracker_last_frame.cpp: the setLocalMap update of the last frame described above.
   void followMapCorrections();
+  // A loop correction moved the whole map by `correction`: every 3D point the last frame holds
+  // (landmarks outside the new snapshot too) moves with it.
+  void followLoopCorrection(const Eigen::Isometry3d& correction);
   void fillKeyframeRequest(const FrameFeatures& frame, uint64_t sequence, double timestamp_s,
                            const Eigen::Isometry3d& T_world_cam, KeyframeRequest* request);
   bool keyframeNeeded(const FrameFeatures& frame, const TrackResult& result) const;

@@ -11,6 +11,23 @@
 
 namespace plumb {
 
+// Landmark associations only: depth points and the pose follow the reference keyframe below
+// (followMapCorrections), which the correction moved by the same motion. Landmarks in the snapshot
+// then take the snapshot's positions there; the others would otherwise stay in the world before
+// the correction (a loop moves the map by centimetres, BA by millimetres).
+void Tracker::followLoopCorrection(const Eigen::Isometry3d& correction) {
+  const FrameFeatures& frame = b_->last_frame;
+  for (std::size_t k = 0; k < frame.keypoints.size(); ++k) {
+    PointAssociation& a = b_->last_points[k];
+    if (a.valid && a.landmark.id != 0) a.P_world = correction * a.P_world;
+  }
+  for (std::size_t k = 0; k < frame.lines.size(); ++k) {
+    LineAssociation& a = b_->last_lines[k];
+    if (!a.valid || a.landmark.id == 0) continue;
+    for (int s = 0; s < a.num_samples; ++s) a.samples_world[s] = correction * a.samples_world[s];
+  }
+}
+
 void Tracker::followMapCorrections() {
   const LocalMap& map = *local_map_;
 

@@ -1,6 +1,7 @@
 // Tracker: pose-only optimisation over the current associations, and pruning of the outliers.
 #include "pipeline/odometry/tracker.h"
 #include "solver/noise_model.h"
+#include "solver/pose_covariance.h"
 
 namespace plumb {
 
@@ -85,6 +86,23 @@ PoseResult Tracker::optimizeAndPrune(const FrameFeatures& frame, const Eigen::Is
     if (a.landmark.id != 0) ++result->landmark_inliers;
   }
   return pose;
+}
+
+void Tracker::publishCovariance(const PoseResult& pose, const Vector6d& twist_per_s, TrackResult* result) const {
+  result->covariance_local_valid = pose.covariance_valid;
+  result->covariance_valid = false;
+  if (!pose.covariance_valid) return;
+  const double variance_factor = varianceFactor(pose.inlier_chi2, 6.0, pose_options_.chi2);
+  result->covariance_local = inflateTrackedCovariance(options_.uncertainty, pose.covariance, variance_factor) +
+                             timingCovariance(options_.uncertainty, camera_.rolling_shutter_readout_s, twist_per_s) +
+                             rollingShutterCovariance(options_.uncertainty, camera_.rolling_shutter_readout_s,
+                                                      options_.uncertainty.rolling_shutter_frame_share);
+  // The map is held exact by pose-only optimisation: covariance_local is the frame relative to
+  // it, i.e. to the reference keyframe, whose world covariance it chains with.
+  if (!local_map_->reference_world_covariance_valid) return;
+  result->covariance = chainPoseCovariance(local_map_->T_world_reference.inverse(), pose.T_cam_world,
+                                           local_map_->reference_world_covariance, result->covariance_local);
+  result->covariance_valid = true;
 }
 
 }  // namespace plumb

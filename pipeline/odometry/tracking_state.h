@@ -25,11 +25,18 @@ struct TrackResult {
   int landmark_inliers = 0;    // inliers that are map landmarks (not last-frame depth points)
   bool used_motion_fallback = false;  // constant velocity failed; wide / zero-motion retry used
   bool keyframe_requested = false;
-  // Covariance of the tracked pose from the final pose-only optimisation (inverse of its robust
-  // Gauss-Newton information): the 6x6 covariance of the left perturbation [rho; phi] of
-  // T_cam_world (solver/se3.h). Invalid when that optimisation did not run or was degenerate.
+  // Covariances of the tracked pose, 6x6 of the left perturbation [rho; phi] of T_cam_world
+  // (solver/se3.h), calibrated (docs/UNCERTAINTY.md). covariance_local: relative to the map, from
+  // the final pose-only optimisation (inverse of its robust Gauss-Newton information, inflated by
+  // UncertaintyOptions::tracked_*); what the frame-to-frame motion (MAVLink's velocity) builds on.
+  // covariance: with respect to the world frame, the reference keyframe's world covariance chained
+  // with covariance_local: what is published as the pose's (MAVLink, API, --track-covariance).
+  // Invalid when the optimisation did not run or was degenerate (or, for `covariance`, the
+  // reference keyframe has no world covariance).
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
   bool covariance_valid = false;
+  Eigen::Matrix<double, 6, 6> covariance_local = Eigen::Matrix<double, 6, 6>::Zero();
+  bool covariance_local_valid = false;
 };
 
 }  // namespace plumb

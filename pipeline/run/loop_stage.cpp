@@ -75,6 +75,12 @@ void LoopStage::keyframeRetired(const RetiredKeyframe& kf, uint64_t epoch) {
   f.covariance_valid = kf.covariance_valid;
   f.T_world_cam = kf.T_world_cam;
   f.covariance = kf.covariance;
+  // The final odometry edge is weighted by the covariance of the relative pose to the previous
+  // keyframe (calibrated, docs/UNCERTAINTY.md) when local BA gave one.
+  if (kf.uncertainty.hasRelative()) {
+    f.covariance = kf.uncertainty.relative_covariance;
+    f.covariance_valid = true;
+  }
   if (synchronous_) {
     processFinal(f);
     return;

@@ -1,6 +1,10 @@
 #pragma once
-// runOdometry(): THE frame loop of plumb. Every way of running the odometry (`plumb run`, `plumb
-// demo`, the system tests, the benchmarks, and every mode) goes through it:
+// runOdometry(): THE frame loop of plumb, and the one place a run is composed: capture -> system
+// -> RunSession (pipeline/run/run_session.h) -> runtime::StageRunner. Every way of running the
+// odometry over a source (`plumb run`, `plumb demo`, the API's runSource, the Python module's
+// run(), the system tests, the benchmarks, and every mode) calls it with its FrameCapture (a
+// FrameSource wrapped by drivers/common/source_capture.h); the push-style API steps the same
+// RunSession itself.
 //
 //   capture (FrameCapture: a sensor or replay, prepared ahead)
 //     -> extract (FeatureExtractor, own per stage)          pipeline/run/odometry_stages.h
@@ -13,17 +17,19 @@
 //   deterministic: lock-step on the calling thread, one frame through all stages before the next
 //     is read. This IS the single-threaded program: every frame sees exactly the map the previous
 //     frames left, so the output is byte-identical run after run.
-//   fast: a thread per stage over SPSC rings, capture and extract working ahead, but the tracker
-//     never runs past a keyframe it asked for (max_frames_ahead_of_mapper 0) and the loop stage
-//     runs on the map stage's thread: every frame is tracked against exactly the map lock-step
-//     would have, so the output is the deterministic output, byte for byte, however loaded the CPU
-//     (only the speed changes). Throughput comes from extraction overlapping track + map.
+//   fast: a thread per stage over SPSC rings, capture and extract working ahead; the map update a
+//     keyframe request of frame k asked for is used from frame k + SystemOptions::map_lag_frames on
+//     as in lock-step (the tracker waits there if the map stage is behind; max_frames_ahead_of_mapper
+//     0) and the loop stage runs on the map stage's thread: every frame is tracked against exactly
+//     the map lock-step would have, so the output is the deterministic output, byte for byte,
+//     however loaded the CPU (only the speed changes). Throughput comes from extraction
+//     overlapping track + map, and tracking overlapping the map stage for the lag's frames.
 //   realtime: a thread per stage; latency first: the tracker may run up to 4 frames past a pending
 //     keyframe on the newest published snapshot (timing dependent), the loop stage has its own
 //     thread. Paces the capture to the recorded timestamps and drops (and counts, and writes as
 //     `# <t> dropped`) a frame that finds no free slot.
 // The sink hears about every frame in frame order, on the map stage's thread. At the end (input
-// ended, max_frames, a stop request or an error) the system is finished: every pose held back for
+// ended, max_frames, a stop request or an error) the session is finished: every pose held back for
 // refinement is delivered to the sink, so a stop or a read error keeps what was computed.
 #include <atomic>
 #include <cstdint>
@@ -40,10 +46,25 @@
 
 namespace plumb {
 
+// What OdometrySink::onFrameView shows of a frame after mapping.
+struct FrameView {
+  const FrameOutput& output;   // the frame, as onFrame had it
+  const RgbdImage& image;      // its colour and depth images, as captured
+  const LocalMap& local_map;   // the mapping side's local map now (LocalMap::version: changed when)
+  const OdometryStats& stats;  // the mapping side's counters (loop_corrections_applied, ...)
+  // The newest loop correction the mapping side applied (valid when stats.loop_corrections_applied
+  // > 0): a viewer draws the loop edge from it.
+  const MapCorrection& last_loop_correction;
+};
+
 // Where a run's results go. Called on the map stage's thread, in frame order.
 class OdometrySink {
  public:
   virtual ~OdometrySink() = default;
+  // Once, when everything has been checked and built and before the first frame (open files here:
+  // a run refused for its options or camera leaves none). The system may be read from the map
+  // stage's callbacks (map counts, statistics).
+  virtual Status begin(const OdometrySystem&) { return Status::Ok(); }
   // The pose of a frame as soon as tracking has it, on the TRACK stage's thread, in frame order
   // (what a robot's controller wants, before mapping refines anything). Must not block: it is on
   // the latency path. Not called for dropped frames.
@@ -55,6 +76,11 @@ class OdometrySink {
   virtual Status onFinishedFrame(const FinishedFrame& frame) = 0;
   // A keyframe that left the map, with its final pose and covariance.
   virtual Status onRetiredKeyframe(const RetiredKeyframe&) { return Status::Ok(); }
+  // For viewers (viewer/, docs/VIEWER.md): after onFrame of a tracked (not dropped) frame and any
+  // loop correction made for it, on the map stage's thread, a read-only look at what the frame
+  // left (below). Nothing else changes those objects during the call, and they are valid only
+  // during it. Must not block or allocate: copy what you need into preallocated storage.
+  virtual void onFrameView(const FrameView&) {}
 };
 
 struct OdometryRunOptions {
@@ -74,11 +100,12 @@ struct OdometryRunOptions {
   // on head250 and synth:repeated it accepts no loop (docs/LOOP.md "Measurements").
   bool loop_closing = true;
   loop::LoopCloserOptions loop;
-  // Threaded runs: frames the tracker may track past a keyframe it asked for before it waits for
-  // the map stage to publish it (bounded staleness, docs/RUNTIME.md "When the map stage falls
-  // behind"). -1 (default): by mode, 0 in fast (lock-step's map, the deterministic bytes) and
-  // kRealtimeFramesAhead in realtime (the tracker does not wait for a local BA; a lagging mapper
-  // backs up into the slot pool and frames drop, counted). Lock-step never waits.
+  // How tracking follows the map stage (docs/RUNTIME.md "When the map stage falls behind"). 0: at
+  // the fixed lag SystemOptions::map_lag_frames, lock-step's map, the deterministic bytes. > 0: the
+  // newest snapshot, tracking at most this many frames past a keyframe it asked for before it
+  // waits for the map stage to publish it (bounded staleness). -1 (default): by mode, 0 in
+  // deterministic and fast, kRealtimeFramesAhead in realtime (the tracker does not wait for a
+  // local BA; a lagging mapper backs up into the slot pool and frames drop, counted).
   int max_frames_ahead_of_mapper = -1;
   static constexpr int kRealtimeFramesAhead = 4;
   // Map files (docs/LOOP.md "Map files"). load_map: the run starts relocalizing into this map (its
@@ -96,7 +123,7 @@ struct OdometryRunOptions {
   }
 };
 
-// Empty Status when usable; otherwise what is wrong (checked by runOdometry before any work).
+// Empty Status when usable; otherwise what is wrong (checked by RunSession::create before any work).
 Status validate(const OdometryRunOptions& options);
 
 // What loop closing did in a run (loop_closing on).
@@ -110,8 +137,35 @@ struct LoopRunResult {
   // Every keyframe of the final graph (id ascending) with its optimised pose: the optimised
   // trajectory re-expresses each frame through its reference keyframe's pose here.
   std::vector<std::pair<uint32_t, Eigen::Isometry3d>> keyframes;
+  // The loop audit (pipeline/loop/loop_audit.h), copied at the end of the run.
+  std::vector<loop::LoopAuditEntry> audit;
+  std::vector<loop::LoopAuditKeyframe> audit_keyframes;
+  uint64_t audit_entries_dropped = 0;
+  uint64_t audit_keyframes_dropped = 0;
   // The pose of `id` in the final graph; false when it is not there (culled, or never received).
   bool keyframePose(uint32_t id, Eigen::Isometry3d* T_world_cam) const;
+  // Parallel to keyframes: each one's final local-map pose and the loop epoch of that pose
+  // (LoopCloser::finalPose; has_final false when it never left the local map).
+  struct FinalPose {
+    bool has_final = false;
+    uint64_t epoch = 0;
+    Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
+  };
+  std::vector<FinalPose> keyframe_finals;
+  // The rigid motion of each loop correction the mapping side applied (OdometrySystem::
+  // appliedCorrections): entry e - 1 takes the world of loop epoch e - 1 to that of epoch e.
+  std::vector<Eigen::Isometry3d> epoch_corrections;
+  // The graph pose of `id` and its final local-map pose expressed in the world of loop epoch
+  // `epoch` (the corrections applied between `epoch` and the epoch the final pose was reported in
+  // undone: they moved the whole local map rigidly, that keyframe included); false when it has no
+  // final pose, or one reported before `epoch`, or those corrections were not recorded.
+  bool keyframeFinalPose(uint32_t id, uint64_t epoch, Eigen::Isometry3d* T_world_graph,
+                         Eigen::Isometry3d* T_world_final) const;
+  // A finished frame's pose in the optimised trajectory (docs/LOOP.md "Two trajectories"): its
+  // real-time pose moved as the graph moved its reference keyframe from the final local-map pose
+  // (in the frame's loop epoch), else its reference keyframe's graph pose times T_ref_cam; false (pose
+  // unchanged) when the frame has no pose or its reference keyframe is not in the graph.
+  bool optimisedPose(const FinishedFrame& frame, Eigen::Isometry3d* T_world_cam) const;
 };
 
 struct OdometryRunResult {
@@ -130,9 +184,16 @@ struct OdometryRunResult {
   uint64_t allocation_frames = 0;
   uint64_t allocations_after_warmup = 0;
   double map_restore_ms = 0;  // load_map: loop closer + relocalizer filled (before the first frame)
+  // The system's counters at the end of the run.
+  OdometryStats odometry;
+  MapperStats mapper;
+  uint64_t mapper_waits = 0;  // threaded runs: times tracking waited for the map stage
 };
 
-Status runOdometry(FrameCapture& capture, OdometrySystem& system, OdometrySink& sink,
+// Builds the system for capture.camera() (options checked there and by validate()), runs every
+// frame of `capture` through it in options.schedule's mode into `sink`, and finishes the run
+// (RunSession). *result is filled also when the run failed part-way (what was computed).
+Status runOdometry(FrameCapture& capture, const SystemOptions& system_options, OdometrySink& sink,
                    const OdometryRunOptions& options, OdometryRunResult* result);
 
 }  // namespace plumb

@@ -56,15 +56,40 @@ void CaptureStage::skip() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// ExtractStage, TrackStage
+// RegisterStage, ExtractStage, TrackStage
 
-ExtractStage::ExtractStage(const OdometrySystem& system)
-    : extractor_(system.camera(), system.options().odometry.extractor) {}
-
-Status ExtractStage::process(OdometrySlot& slot, const runtime::FrameStamps&) {
+Status RegisterStage::process(OdometrySlot& slot, const runtime::FrameStamps&) {
   const auto start = std::chrono::steady_clock::now();
+  slot.depth_registered =
+      registration_.registerInto(slot.image.depth_raw, slot.image.depth_factor, slot.registered_depth);
+  // A depth image that does not fit the depth camera is not guessed at: the frame goes on without
+  // depth (2D-only features), counted.
+  if (!slot.depth_registered) ++failures_;
+  slot.register_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return Status::Ok();
+}
+
+ExtractStage::ExtractStage(const OdometrySystem& system, uint32_t stride, uint32_t offset)
+    : extractor_(system.camera(), system.options().odometry.extractor),
+      stride_(stride),
+      offset_(offset),
+      registered_depth_(!system.camera().depthRegistered()) {}
+
+const char* ExtractStage::name() const {
+  if (stride_ == 1) return "extract";
+  return offset_ == 0 ? "extract-even" : "extract-odd";
+}
+
+Status ExtractStage::process(OdometrySlot& slot, const runtime::FrameStamps& stamps) {
+  if (stamps.frame_index % stride_ != offset_) return Status::Ok();
+  const auto start = std::chrono::steady_clock::now();
+  // Unregistered depth is never read as it came: registered, or none at all.
+  static const cv::Mat kNoDepth;
+  const cv::Mat& depth = !registered_depth_ ? slot.image.depth_raw
+                         : slot.depth_registered ? slot.registered_depth
+                                                 : kNoDepth;
   // A frame that does not fit the camera is tracked featureless (and counted): it keeps its place.
-  if (!extractor_.extract(slot.image, *slot.features)) {
+  if (!extractor_.extract(slot.image.bgr, depth, slot.image.depth_factor, *slot.features)) {
     slot.features->clear();
     ++failures_;
   }
@@ -75,6 +100,7 @@ Status ExtractStage::process(OdometrySlot& slot, const runtime::FrameStamps&) {
 Status TrackStage::process(OdometrySlot& slot, const runtime::FrameStamps&) {
   system_.trackFeatures(*slot.features, slot.image.sequence, slot.image.timestamp_s, &fence_, slot.tracked.get());
   slot.tracked->output.extract_ms = slot.extract_ms;
+  slot.tracked->output.register_ms = slot.register_ms;
   slot.tracked->output.t_sensor_ns = slot.image.t_sensor_ns;
   fence_.frameTracked();
   sink_.onPose(slot.tracked->output);
@@ -84,15 +110,28 @@ Status TrackStage::process(OdometrySlot& slot, const runtime::FrameStamps&) {
 // ---------------------------------------------------------------------------------------------
 // MapStage
 
-Status MapStage::deliver(const FrameOutput& out) {
-  Status status = sink_.onFrame(out);
-  system_.drainFinishedFrames([&](const FinishedFrame& f) {
-    if (status.ok()) status = sink_.onFinishedFrame(f);
-  });
+void MapStage::drain(bool end_of_run, Status* status) {
+  system_.drainFinishedFrames(
+      [&](const FinishedFrame& f) {
+        if (status->ok()) *status = sink_.onFinishedFrame(f);
+      },
+      end_of_run);
+  if (end_of_run) system_.retireAllKeyframes();
   system_.drainRetiredKeyframes([&](const RetiredKeyframe& kf) {
     if (loop_ != nullptr) loop_->keyframeRetired(kf, system_.stats().loop_corrections_applied);
-    if (status.ok()) status = sink_.onRetiredKeyframe(kf);
+    if (status->ok()) *status = sink_.onRetiredKeyframe(kf);
   });
+}
+
+Status MapStage::deliver(const FrameOutput& out) {
+  Status status = sink_.onFrame(out);
+  drain(false, &status);
+  return status;
+}
+
+Status MapStage::deliverTheRest() {
+  Status status;
+  drain(true, &status);
   return status;
 }
 
@@ -120,6 +159,8 @@ Status MapStage::process(OdometrySlot& slot, const runtime::FrameStamps& stamps)
   // frame retired carry poses from before the correction, so they go to the closer with the epoch
   // of before it.
   if (loop_ != nullptr && loop_->synchronous()) system_.applyLoopCorrection();
+  sink_.onFrameView(FrameView{out, slot.image, system_.mapper().localMap(), system_.stats(),
+                              system_.lastLoopCorrection()});
   // Process-wide count, read on this thread after each frame: from the first frame at or after
   // warm-up to the last one finished before the input ended, every thread's allocations are
   // included. The count is read before the flag, so a reading taken after a stage thread began

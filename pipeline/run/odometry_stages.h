@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 
+#include "pipeline/frontend/depth_registration.h"
 #include "pipeline/frontend/feature_extractor.h"
 #include "pipeline/odometry/mapper_fence.h"
 #include "pipeline/odometry/odometry_system.h"
@@ -24,6 +25,11 @@ struct OdometrySlot {
   RgbdImage image;
   std::unique_ptr<FrameFeatures> features = std::make_unique<FrameFeatures>();
   std::unique_ptr<TrackedFrame> tracked = std::make_unique<TrackedFrame>();  // track -> map
+  // Unregistered depth cameras only: image.depth_raw registered into the colour camera by the
+  // register stage (sized once, with the pool), and whether this frame's is valid.
+  cv::Mat registered_depth;
+  bool depth_registered = false;
+  double register_ms = 0;
   double extract_ms = 0;
   uint32_t dropped_before = 0;  // DropLog entries that precede this frame
 };
@@ -66,16 +72,42 @@ class CaptureStage final : public runtime::Source<OdometrySlot> {
   bool stopped_ = false;
 };
 
-// Stage 1: its own FeatureExtractor (extractors are one per thread), the system's camera and options.
+// Stage 1 when the camera's depth is not registered to colour (PinholeCamera::depth_camera; RunSession
+// leaves it out otherwise): image.depth_raw, as the depth camera saw it, into the colour camera
+// (pipeline/frontend/depth_registration.h), once per frame, into the slot's registered_depth.
+class RegisterStage final : public runtime::Stage<OdometrySlot> {
+ public:
+  explicit RegisterStage(const PinholeCamera& camera) : registration_(camera) {}
+  const char* name() const override { return "register"; }
+  Status process(OdometrySlot& slot, const runtime::FrameStamps&) override;
+  // Whether the camera needs it (a stage that would do nothing is not run at all).
+  bool needed() const { return registration_.active(); }
+  // Frames whose depth image did not fit the depth camera (their features are 2D-only).
+  uint64_t failures() const { return failures_; }
+
+ private:
+  DepthRegistration registration_;
+  uint64_t failures_ = 0;
+};
+
+// After the register stage, if any: its own FeatureExtractor (extractors are one per thread), the
+// system's camera and options; reads the registered depth when there is a register stage. With
+// stride 2 two of them follow each other in the chain, one extracting the even frames and passing
+// the odd ones on, the other the reverse: the threaded modes extract two frames at once on two
+// threads without fan-out (extraction is a function of the frame alone, so the features, and the
+// bytes, are those of one extractor).
 class ExtractStage final : public runtime::Stage<OdometrySlot> {
  public:
-  explicit ExtractStage(const OdometrySystem& system);
-  const char* name() const override { return "extract"; }
-  Status process(OdometrySlot& slot, const runtime::FrameStamps&) override;
+  explicit ExtractStage(const OdometrySystem& system, uint32_t stride = 1, uint32_t offset = 0);
+  const char* name() const override;
+  // Frames whose runner index is offset modulo stride; the others pass through untouched.
+  Status process(OdometrySlot& slot, const runtime::FrameStamps& stamps) override;
   uint64_t failures() const { return failures_; }
 
  private:
   FeatureExtractor extractor_;
+  uint32_t stride_, offset_;
+  bool registered_depth_ = false;  // read slot.registered_depth (there is a register stage)
   uint64_t failures_ = 0;
 };
 
@@ -105,6 +137,9 @@ class MapStage final : public runtime::Stage<OdometrySlot> {
   // Frames dropped after the last processed one (the capture has finished).
   void finish() override;
   const Status& finishStatus() const { return finish_status_; }
+  // The end of a run, after finish() and the loop stage's last correction: every frame held back
+  // for refinement and then every keyframe reach the sink (and retired keyframes the loop stage).
+  Status deliverTheRest();
   uint64_t frames() const { return frames_; }
   uint64_t framesDropped() const { return frames_dropped_; }
   uint64_t framesAfterWarmup() const { return frames_after_warmup_; }
@@ -113,6 +148,9 @@ class MapStage final : public runtime::Stage<OdometrySlot> {
  private:
   Status writeDrops(uint32_t count);
   Status deliver(const FrameOutput& out);
+  // Finished frames, then retired keyframes, to the sink; a failure is kept in *status (the first
+  // one), after which the sink hears of nothing more.
+  void drain(bool end_of_run, Status* status);
 
   OdometrySystem& system_;
   MapperFence& fence_;

@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "pipeline/odometry/map_capacities.h"
+#include "pipeline/run/loop_audit_json.h"
 #include "platform/process_memory.h"
 #include "runtime/json_text.h"
 
@@ -26,7 +27,11 @@ void RunStatistics::add(const FrameOutput& frame) {
   extract_.add(ns(frame.extract_ms));
   track_.add(ns(frame.track_ms));
   map_.add(ns(frame.map_ms));
-  total_.add(ns(frame.extract_ms + frame.track_ms + frame.map_ms));
+  if (frame.register_ms > 0) {
+    ++frames_registered_;
+    register_.add(ns(frame.register_ms));
+  }
+  total_.add(ns(frame.register_ms + frame.extract_ms + frame.track_ms + frame.map_ms));
   if (rss_every_ > 0 && frames_ % uint64_t(rss_every_) == 0 && rss_.size() < max_checkpoints_) {
     RssCheckpoint c;
     c.frame = frames_;
@@ -80,6 +85,8 @@ std::string runSummaryJson(const RunSummary& r) {
   };
   out += "  \"ms_per_frame\": {\n";
   timing("total", r.statistics->totalNs(), false);
+  // Only runs that registered depth have the row, so the statistics of others are unchanged.
+  if (r.statistics->framesRegistered() > 0) timing("register", r.statistics->registerNs(), false);
   timing("extract", r.statistics->extractNs(), false);
   timing("track", r.statistics->trackNs(), false);
   timing("map", r.statistics->mapNs(), true);
@@ -128,6 +135,7 @@ std::string runSummaryJson(const RunSummary& r) {
     add(std::snprintf(buf, sizeof(buf),
                       "    \"edges_refined\": %" PRIu64 ", \"optimisations\": %" PRIu64 ", \"optimisation_ms_total\": %.3f, \"optimisation_ms_max\": %.3f},\n",
                       ls.edges_refined, ls.optimisations, ls.optimisation_ms_total, ls.optimisation_ms_max));
+    out += loopAuditJson(lr) + ",\n";
   }
   if (r.map_loaded || !r.map_saved_path.empty()) {
     add(std::snprintf(buf, sizeof(buf),

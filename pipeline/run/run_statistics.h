@@ -35,13 +35,16 @@ class RunStatistics {
   const runtime::LatencyHistogram& extractNs() const { return extract_; }
   const runtime::LatencyHistogram& trackNs() const { return track_; }
   const runtime::LatencyHistogram& mapNs() const { return map_; }
+  // Depth registration (unregistered depth cameras): frames it ran on, and its milliseconds.
+  uint64_t framesRegistered() const { return frames_registered_; }
+  const runtime::LatencyHistogram& registerNs() const { return register_; }
   const std::vector<RssCheckpoint>& rss() const { return rss_; }
 
  private:
   long rss_every_;
   std::size_t max_checkpoints_;
-  uint64_t frames_ = 0, frames_dropped_ = 0;
-  runtime::LatencyHistogram total_, extract_, track_, map_;
+  uint64_t frames_ = 0, frames_dropped_ = 0, frames_registered_ = 0;
+  runtime::LatencyHistogram total_, extract_, track_, map_, register_;
   std::vector<RssCheckpoint> rss_;
 };
 

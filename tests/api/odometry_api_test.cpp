@@ -4,6 +4,10 @@
 // bad input with a message.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <fstream>
+#include <string>
+
 #include <memory>
 #include <vector>
 
@@ -192,6 +196,21 @@ TEST(OdometryApi, BadInputIsRefusedWithAMessage) {
   st = odometry->track(view(frames, 1), &out);
   EXPECT_FALSE(st.ok);
   EXPECT_NE(st.message.find("finish"), std::string::npos) << st.message;
+}
+
+// CameraValues have no depth camera: a camera file describing one (unregistered depth) is refused
+// rather than read as registered (docs/DATA_FORMATS.md "Unregistered depth").
+TEST(OdometryApi, CameraFileWithAnUnregisteredDepthCameraIsRefused) {
+  const std::string path = ::testing::TempDir() + "plumb_api_unregistered_depth.txt";
+  std::ofstream(path) << "fx 525\nfy 525\ncx 319.5\ncy 239.5\ndepth_fx 575\ndepth_fy 575\ndepth_cx 314\n"
+                         "depth_cy 243\ndepth_width 640\ndepth_height 480\ndepth_to_colour_qx 0\n"
+                         "depth_to_colour_qy 0\ndepth_to_colour_qz 0\ndepth_to_colour_qw 1\n"
+                         "depth_to_colour_tx 0.025\ndepth_to_colour_ty 0\ndepth_to_colour_tz 0\n";
+  CameraValues values;
+  const Status st = resolveCamera(CameraSpec::named(path), &values);
+  std::remove(path.c_str());
+  ASSERT_FALSE(st.ok);
+  EXPECT_NE(st.message.find("not registered to colour"), std::string::npos) << st.message;
 }
 
 TEST(OdometryApi, CameraFromPresetFileOrValues) {

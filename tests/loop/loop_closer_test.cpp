@@ -239,3 +239,69 @@ TEST(LoopCloser, ResidencyStepsChangeNothingAndFinish) {
 
 }  // namespace
 }  // namespace plumb::test
+
+namespace plumb::test {
+namespace {
+
+// Do no harm (loop_context_check.h): a loop whose measurement contradicts the keyframes around
+// both sides is rolled back. Lap 2 of a circle with exact odometry; keyframe kFake's record holds
+// the view of a place kShift keyframes further on (as a repeated piece of furniture would look),
+// so verification measures a loop to that place: a 0.3 m / 18 deg jump. Plausibility is switched
+// off (its chi-square bound made huge) so that the jump reaches the graph; consistency and
+// cooldown are switched off so that this single keyframe is verified. The query's predecessors
+// and the candidate's neighbours see the true geometry: the correction makes their common points
+// reproject worse, and the loop is undone (no correction, graph as before, counted).
+struct FakeLoopRun {
+  bool fake_accepted = false;
+  uint64_t rolled_back = 0;
+  loop::LoopAuditEntry fake_entry;
+  double pose_change_m = 0;  // of the fake keyframe's graph pose, against its odometry
+};
+
+FakeLoopRun runFakeLoop(bool context_check) {
+  const Scene scene = cylinderScene(21, 6000, 3.5);
+  constexpr int kPerLap = 100, kFake = 112, kShift = 5;
+  auto pose_at = [&](int k) { return outwardPose(2 * M_PI * k / kPerLap, 1.0); };
+  loop::LoopCloserOptions options;
+  options.capacity = 256;
+  options.plausibility_chi2 = 1e12;
+  options.min_consistent = 1;
+  options.cooldown_keyframes = 0;
+  options.context_check = context_check;
+  loop::LoopCloser closer = makeCloser(options);
+  FakeLoopRun out;
+  for (int k = 0; k <= kFake; ++k) {
+    const Eigen::Isometry3d step = k > 0 ? pose_at(k - 1).inverse() * pose_at(k) : Eigen::Isometry3d::Identity();
+    const Eigen::Isometry3d seen = k == kFake ? pose_at(k + kShift) : pose_at(k);
+    const auto record = recordOf(scene, uint32_t(k + 1), seen, pose_at(k), k > 0 ? uint32_t(k) : 0, step);
+    const bool accepted = closer.addKeyframe(*record);
+    if (k == kFake) out.fake_accepted = accepted;
+  }
+  out.rolled_back = closer.stats().rejected[int(loop::LoopRejection::kRolledBack)];
+  for (const loop::LoopAuditEntry& e : closer.audit().entries()) {
+    if (e.query_id == uint32_t(kFake + 1) && e.ransac_inliers > 0) out.fake_entry = e;
+  }
+  Eigen::Isometry3d T;
+  EXPECT_TRUE(closer.pose(uint32_t(kFake + 1), &T));
+  out.pose_change_m = translationError(T, pose_at(kFake));
+  return out;
+}
+
+TEST(LoopCloser, ALoopThatMakesTheCovisibleLandmarksWorseIsRolledBack) {
+  const FakeLoopRun without = runFakeLoop(false);
+  // The mechanism matters: without the check the jump is applied.
+  ASSERT_TRUE(without.fake_accepted);
+  EXPECT_GT(without.pose_change_m, 0.03);
+  EXPECT_GT(without.fake_entry.correction_m, 0.2);
+
+  const FakeLoopRun with = runFakeLoop(true);
+  EXPECT_FALSE(with.fake_accepted);
+  EXPECT_GE(with.rolled_back, 1u);
+  EXPECT_EQ(with.fake_entry.outcome, loop::LoopRejection::kRolledBack);
+  EXPECT_GT(with.fake_entry.context_matches, 100);
+  EXPECT_GT(with.fake_entry.context_cost_after, 1.5 * with.fake_entry.context_cost_before);
+  EXPECT_LT(with.pose_change_m, 1e-6);  // the graph is as it was
+}
+
+}  // namespace
+}  // namespace plumb::test

@@ -150,3 +150,61 @@ TEST(MavlinkCovariance, UpperTriangleIsRowMajor) {
 
 }  // namespace
 }  // namespace plumb
+
+namespace plumb {
+namespace {
+
+// The velocity covariance (odometry_frames.h) against sampling: two consecutive poses perturbed by
+// independent errors from their map-relative covariances, the velocity computed exactly as the
+// sink sends it (body frame, differenced over dt), its sample covariance vs the formula.
+TEST(MavlinkFrames, VelocityCovarianceMatchesSampling) {
+  std::mt19937 rng(9);
+  std::normal_distribution<double> n(0.0, 1.0);
+  MavlinkFrameChange frames;
+  frames.T_body_cam.translation() = Eigen::Vector3d(0.4, -0.1, 0.2);  // a lever arm
+  const Eigen::Isometry3d T_world_cam_previous = pose(Eigen::Vector3d(0.2, -0.4, 0.1), Eigen::Vector3d(0.5, 0.2, 1.0));
+  const Eigen::Isometry3d T_world_cam = T_world_cam_previous * pose(Eigen::Vector3d(0.01, 0.015, -0.005),
+                                                                    Eigen::Vector3d(0.02, -0.01, 0.03));
+  const double dt = 1.0 / 30.0;
+  Matrix6d A = Matrix6d::Zero(), B = Matrix6d::Zero();
+  for (int r = 0; r < 6; ++r)
+    for (int c = 0; c < 6; ++c) {
+      A(r, c) = n(rng);
+      B(r, c) = n(rng);
+    }
+  const Matrix6d L_previous = 1e-6 * (A * A.transpose() / 6 + 0.2 * Matrix6d::Identity());
+  const Matrix6d L = 1e-6 * (B * B.transpose() / 6 + 0.2 * Matrix6d::Identity());
+  const Matrix6d chol_previous = L_previous.llt().matrixL(), chol = L.llt().matrixL();
+  auto velocity = [&](const Eigen::Isometry3d& previous, const Eigen::Isometry3d& current) {
+    const Eigen::Isometry3d P = localBodyPose(previous, frames), C = localBodyPose(current, frames);
+    Vector6d v;
+    v << C.linear().transpose() * (C.translation() - P.translation()) / dt,
+        logSO3(P.linear().transpose() * C.linear()) / dt;
+    return v;
+  };
+  const Vector6d v0 = velocity(T_world_cam_previous, T_world_cam);
+  const int samples = 40000;
+  Matrix6d sum = Matrix6d::Zero();
+  for (int k = 0; k < samples; ++k) {
+    Vector6d z0, z1;
+    for (int i = 0; i < 6; ++i) {
+      z0(i) = n(rng);
+      z1(i) = n(rng);
+    }
+    const Eigen::Isometry3d previous = applyLeftIncrement(chol_previous * z0, T_world_cam_previous.inverse()).inverse();
+    const Eigen::Isometry3d current = applyLeftIncrement(chol * z1, T_world_cam.inverse()).inverse();
+    const Vector6d dv = velocity(previous, current) - v0;
+    sum += dv * dv.transpose();
+  }
+  const Matrix6d sampled = sum / samples;
+  const Matrix6d predicted = mavlinkVelocityCovariance(L_previous, L, T_world_cam_previous, T_world_cam, dt, frames);
+  EXPECT_LT((sampled - predicted).norm(), 0.04 * predicted.norm()) << "sampled\n" << sampled << "\npredicted\n" << predicted;
+  // Ignoring the lever arm (the adjoint) would be visibly wrong.
+  MavlinkFrameChange no_lever = frames;
+  no_lever.T_body_cam.translation().setZero();
+  const Matrix6d wrong = mavlinkVelocityCovariance(L_previous, L, T_world_cam_previous, T_world_cam, dt, no_lever);
+  EXPECT_GT((sampled - wrong).norm(), 0.1 * predicted.norm());
+}
+
+}  // namespace
+}  // namespace plumb

@@ -165,6 +165,35 @@ TEST(MavlinkSink, ExplicitLocalFrameIsUsed) {
   EXPECT_NEAR(m.x, 10.0, 0.01);
 }
 
+// The velocity covariance: from the two poses' map-relative covariances (odometry_frames.h) when
+// both samples carry one, unknown (NaN) otherwise.
+TEST(MavlinkSink, VelocityCovarianceFromConsecutiveLocalCovariances) {
+  UdpReceiver rx;
+  MavlinkOdometrySink sink;
+  ASSERT_TRUE(sink.open(udpOptions(rx.port)).ok());
+  const MavlinkFrameChange frames;
+  MavlinkOdometry m;
+  OdometrySample s0 = sampleAt(0), s1 = sampleAt(1), s2 = sampleAt(2);
+  Matrix6d L = Matrix6d::Identity() * 1e-6;
+  L(0, 3) = L(3, 0) = 2e-7;
+  for (OdometrySample* s : {&s0, &s1}) {
+    s->has_local_covariance = true;
+    s->local_covariance = L;
+  }
+  sink.buildOdometry(s0, &m);
+  EXPECT_TRUE(std::isnan(m.velocity_covariance[0]));  // no velocity yet
+  sink.buildOdometry(s1, &m);
+  const Matrix6d expected =
+      mavlinkVelocityCovariance(L, L, s0.T_world_cam, s1.T_world_cam, s1.timestamp_s - s0.timestamp_s, frames);
+  int i = 0;
+  for (int r = 0; r < 6; ++r)
+    for (int c = r; c < 6; ++c, ++i)
+      EXPECT_NEAR(m.velocity_covariance[i], expected(r, c), 1e-6 * expected.cwiseAbs().maxCoeff()) << r << " " << c;
+  EXPECT_GT(m.velocity_covariance[0], 0.f);
+  sink.buildOdometry(s2, &m);  // s2 has no local covariance
+  EXPECT_TRUE(std::isnan(m.velocity_covariance[0]));
+}
+
 TEST(MavlinkSink, UdpRoundTripDecodesToFrameChangedPose) {
   UdpReceiver rx;
   MavlinkOdometrySink sink;

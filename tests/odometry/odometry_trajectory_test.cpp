@@ -206,5 +206,28 @@ TEST(OdometryTrajectory, AFullQueueRefusesInsteadOfOverwriting) {
   for (int i = 0; i < kMax; ++i) EXPECT_EQ(out.frames[std::size_t(i)].sequence, uint64_t(i));
 }
 
+TEST(OdometryTrajectory, AFrameQueuedBeforeALoopCorrectionKeepsItsWorld) {
+  // A loop correction moves the whole map by C while frames wait in the queue. They were tracked
+  // (and sent to the robot) before it: they keep the world they were tracked in, BA refinements
+  // of their keyframe included; frames queued after the correction are in the corrected world.
+  const Eigen::Isometry3d T_world_ref = pose(5, Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0.5, 0, 0));
+  const Eigen::Isometry3d C = pose(2, Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0.08, -0.05, 0.02));
+  const Eigen::Isometry3d refine = pose(0.3, Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0.004, 0, 0));
+  OdometryTrajectory trajectory(3);
+  trajectory.push(0, 0.0, true, T_world_ref * frameOffset(1), 7, frameOffset(1));
+  trajectory.setWorld(1, 0, 1, C);  // the mapper applied the correction
+  trajectory.push(1, 0.1, true, C * T_world_ref * frameOffset(2), 7, frameOffset(2));
+  LocalMap map = mapWithKeyframes({{7, C * refine * T_world_ref}});
+  map.loop_corrections = 1;
+  map.T_loop_corrections = C;
+  Collector out;
+  trajectory.flushAll(map, out.fn());
+  ASSERT_EQ(out.frames.size(), 2u);
+  EXPECT_TRUE(out.frames[0].T_world_cam.isApprox(refine * T_world_ref * frameOffset(1), 1e-12));
+  EXPECT_EQ(out.frames[0].loop_epoch, 0u);
+  EXPECT_TRUE(out.frames[1].T_world_cam.isApprox(C * refine * T_world_ref * frameOffset(2), 1e-12));
+  EXPECT_EQ(out.frames[1].loop_epoch, 1u);
+}
+
 }  // namespace
 }  // namespace plumb

@@ -277,5 +277,38 @@ TEST(Tracker, LastFrameFollowsTheCorrectionsOfANewSnapshot) {
   }
 }
 
+TEST(Tracker, ALoopCorrectionMovesLandmarksTheSnapshotDoesNotList) {
+  // A loop correction moves the whole map rigidly (LocalMapper::applyCorrection). The last frame's
+  // landmark associations must move with it even when the new snapshot does not list those
+  // landmarks (a snapshot holds at most kMaxLocalMapPoints / kMaxLocalMapLines of the map, and
+  // only the covisible neighbourhood of the reference keyframe): before the fix they kept their
+  // pre-correction positions while the frame's pose and depth points moved, so the next frame was
+  // tracked against a mix of two worlds several centimetres apart.
+  const test::Scene scene = test::makeScene(11, 300, 40, kStart);
+  const Eigen::Isometry3d T1 = kStart * kStep, T2 = T1 * kStep;
+  const Eigen::Isometry3d C = pose(1.5, Eigen::Vector3d(0.2, 1, 0.3), Eigen::Vector3d(0.06, -0.04, 0.03));
+  for (const bool lines_only : {false, true}) {
+    Fixture fx;
+    const InsertResult start = fx.startMap(*test::observe(scene, kStart).features, 0, kStart);
+    ASSERT_TRUE(start.inserted);
+    test::View v1 = test::observe(scene, T1);
+    if (lines_only) v1.features->keypoints.clear(), v1.features->keypoint_descriptors.clear();
+    ASSERT_EQ(fx.tracker->track(*v1.features, 1, 0.1, nullptr).state, TrackingState::kOk);
+    ASSERT_TRUE(fx.mapper->applyCorrection(MapCorrection{start.keyframe_id, C * kStart}));
+    auto snapshot = std::make_unique<LocalMap>(fx.mapper->localMap());
+    EXPECT_EQ(snapshot->loop_corrections, 1u);
+    snapshot->points.clear();  // none of the landmarks is in the snapshot
+    snapshot->lines.clear();
+    fx.tracker->setLocalMap(*snapshot);
+    test::View v2 = test::observe(scene, T2);
+    if (lines_only) v2.features->keypoints.clear(), v2.features->keypoint_descriptors.clear();
+    const TrackResult r = fx.tracker->track(*v2.features, 2, 0.2, nullptr);
+    ASSERT_NE(r.state, TrackingState::kLost) << (lines_only ? "lines" : "points and lines");
+    // The scene seen from T2 in the world before the correction is the corrected world's C T2.
+    EXPECT_LT(translationError(r.T_world_cam, C * T2), 1e-4) << (lines_only ? "lines" : "points and lines");
+    EXPECT_LT(rotationErrorDeg(r.T_world_cam, C * T2), 0.01) << (lines_only ? "lines" : "points and lines");
+  }
+}
+
 }  // namespace
 }  // namespace plumb

@@ -202,5 +202,33 @@ TEST(FrontendKernels, LineDescriptorEqualsItsScalarDefinition) {
   EXPECT_GT(distinct, 250);  // the descriptors depend on the segment
 }
 
+// hammingDistance (SSE2 bit-slicing on x86-64 without popcnt) against a bit-by-bit count.
+TEST(FrontendKernels, HammingDistanceCountsDifferingBits) {
+  cv::RNG rng(21);
+  auto randomWord = [&rng] { return (uint64_t(uint32_t(rng)) << 32) | uint32_t(rng); };
+  for (int i = 0; i < 2000; ++i) {
+    Descriptor256 a, b;
+    for (int w = 0; w < 4; ++w) {
+      a.words[w] = randomWord();
+      // Every pattern of agreement: equal words, complements, sparse and dense differences.
+      switch (i % 4) {
+        case 0: b.words[w] = randomWord(); break;
+        case 1: b.words[w] = a.words[w] ^ (uint64_t(1) << (rng.uniform(0, 64))); break;
+        case 2: b.words[w] = ~a.words[w]; break;
+        default: b.words[w] = w == i % 3 ? a.words[w] : randomWord(); break;
+      }
+    }
+    int expected = 0;
+    for (int w = 0; w < 4; ++w)
+      for (int bit = 0; bit < 64; ++bit) expected += int(((a.words[w] ^ b.words[w]) >> bit) & 1);
+    ASSERT_EQ(hammingDistance(a, b), expected) << "pair " << i;
+    ASSERT_EQ(hammingDistance(b, a), expected);
+    ASSERT_EQ(hammingDistance(a, a), 0);
+  }
+  Descriptor256 zero, ones;
+  ones.words = {~uint64_t(0), ~uint64_t(0), ~uint64_t(0), ~uint64_t(0)};
+  EXPECT_EQ(hammingDistance(zero, ones), 256);
+}
+
 }  // namespace
 }  // namespace plumb

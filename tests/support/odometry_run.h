@@ -1,6 +1,6 @@
 #pragma once
-// Test helpers: run the odometry over a FrameSource through THE runner (pipeline/run/odometry_run.h,
-// the same loop `plumb run` uses) and collect the trajectory, per-frame outputs and counters.
+// Test helpers: run the odometry over a FrameSource through runOdometry() (pipeline/run/odometry_run.h,
+// the composition `plumb run` uses) and collect the trajectory, per-frame outputs and counters.
 // GeneratedSource makes a FrameSource of frames a test draws itself (blank frames, scene cuts).
 #include <algorithm>
 #include <functional>
@@ -25,7 +25,7 @@ struct OdometryRun {
   // The optimised trajectory (docs/LOOP.md): each frame through its reference keyframe's pose in
   // the final loop-closing graph; the real-time pose where the keyframe is not in the graph.
   std::vector<StampedPose> optimized;
-  std::vector<std::pair<uint32_t, Eigen::Isometry3d>> references;  // per frame: (id, T_ref_cam)
+  std::vector<FinishedFrame> finished;  // per frame, as the sink received it
   std::vector<FrameOutput> outputs;     // per frame as mapped (when asked for)
   OdometryStats stats;
   MapperStats mapper;
@@ -36,12 +36,18 @@ struct OdometryRun {
 // Collects what the runner delivers; reads the map counts on the map stage's thread.
 class CollectingSink final : public OdometrySink {
  public:
-  CollectingSink(const OdometrySystem& system, bool keep_outputs, OdometryRun* run)
-      : system_(system), keep_outputs_(keep_outputs), run_(run) {}
+  CollectingSink(bool keep_outputs, OdometryRun* run) : keep_outputs_(keep_outputs), run_(run) {}
+  Status begin(const OdometrySystem& system) override {
+    system_ = &system;
+    return Status::Ok();
+  }
+  void onPose(const FrameOutput& out) override {
+    if (on_pose) on_pose(out);
+  }
   Status onFrame(const FrameOutput& out) override {
     if (on_frame) on_frame(out);
     if (keep_outputs_) run_->outputs.push_back(out);
-    const MapCounts c = system_.mapCounts();
+    const MapCounts c = system_->mapCounts();
     run_->max_keyframes = std::max(run_->max_keyframes, c.keyframes);
     run_->max_points = std::max(run_->max_points, c.points);
     run_->max_lines = std::max(run_->max_lines, c.lines);
@@ -49,14 +55,16 @@ class CollectingSink final : public OdometrySink {
   }
   Status onFinishedFrame(const FinishedFrame& f) override {
     run_->trajectory.push_back(toStampedPose(f));
-    run_->references.emplace_back(f.reference_id, f.T_ref_cam);
+    run_->finished.push_back(f);
     return Status::Ok();
   }
   // Called first in onFrame(), on the map stage's thread (e.g. to make the map stage slow).
   std::function<void(const FrameOutput&)> on_frame;
+  // Called in onPose(), on the track stage's thread.
+  std::function<void(const FrameOutput&)> on_pose;
 
  private:
-  const OdometrySystem& system_;
+  const OdometrySystem* system_ = nullptr;
   bool keep_outputs_;
   OdometryRun* run_;
 };
@@ -68,31 +76,31 @@ struct RunSettings {
   bool loop_closing = true;
   int max_frames_ahead_of_mapper = -1;  // OdometryRunOptions: -1 = by mode
   std::function<void(const FrameOutput&)> on_frame;  // CollectingSink::on_frame
+  std::function<void(const FrameOutput&)> on_pose;   // CollectingSink::on_pose
 };
 
 inline OdometryRun runOdometry(FrameSource& source, const SystemOptions& options, const RunSettings& settings = {}) {
   OdometryRun run;
-  std::unique_ptr<OdometrySystem> system;
-  run.status = OdometrySystem::create(source.camera(), options, &system);
-  if (!run.status.ok()) return run;
-  CollectingSink sink(*system, settings.keep_outputs, &run);
+  // Sized up front when the source knows its length, so the sink does not allocate per frame and
+  // the run's own allocation count (OdometryRunResult::allocations_after_warmup) is the pipeline's.
+  run.trajectory.reserve(source.frameCount());
+  run.finished.reserve(source.frameCount());
+  CollectingSink sink(settings.keep_outputs, &run);
   sink.on_frame = settings.on_frame;
+  sink.on_pose = settings.on_pose;
   SourceCapture capture(source);
   OdometryRunOptions run_options;
   run_options.schedule.mode = settings.mode;
   run_options.max_frames = settings.max_frames;
   run_options.loop_closing = settings.loop_closing;
   run_options.max_frames_ahead_of_mapper = settings.max_frames_ahead_of_mapper;
-  run.status = runOdometry(capture, *system, sink, run_options, &run.result);
+  run.status = runOdometry(capture, options, sink, run_options, &run.result);
   run.optimized = run.trajectory;
   for (std::size_t i = 0; i < run.optimized.size(); ++i) {
-    Eigen::Isometry3d T_world_ref;
-    if (run.optimized[i].valid && run.result.loop.keyframePose(run.references[i].first, &T_world_ref)) {
-      run.optimized[i].T_world_cam = T_world_ref * run.references[i].second;
-    }
+    (void)run.result.loop.optimisedPose(run.finished[i], &run.optimized[i].T_world_cam);
   }
-  run.stats = system->stats();
-  run.mapper = system->mapperStats();
+  run.stats = run.result.odometry;
+  run.mapper = run.result.mapper;
   return run;
 }
 

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "tests/support/odometry_run.h"
+#include "tests/support/same_trajectory.h"
 
 namespace plumb::test {
 namespace {
@@ -30,20 +31,6 @@ OdometryRun runScene(const SynthOptions& options, bool loops, std::vector<Stampe
   if (gt != nullptr) *gt = groundTruth(source->scene(), options.frames);
   settings.loop_closing = loops;
   return runOdometry(*source, systemOptions(true), settings);
-}
-
-// Exactly equal, bit for bit (what the trajectory file's bytes depend on).
-::testing::AssertionResult sameTrajectory(const std::vector<StampedPose>& a, const std::vector<StampedPose>& b) {
-  if (a.size() != b.size()) return ::testing::AssertionFailure() << a.size() << " vs " << b.size() << " frames";
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    if (a[i].timestamp != b[i].timestamp || a[i].valid != b[i].valid ||
-        !(a[i].T_world_cam.matrix().array() == b[i].T_world_cam.matrix().array()).all()) {
-      return ::testing::AssertionFailure() << "frame " << i << " differs: t " << a[i].timestamp << " position "
-                                           << a[i].T_world_cam.translation().transpose() << " vs "
-                                           << b[i].T_world_cam.translation().transpose();
-    }
-  }
-  return ::testing::AssertionSuccess();
 }
 
 TEST(LoopClosing, SynthLoopOptimisedAteAtMostHalfOfNoLoopClosing) {

@@ -1,12 +1,16 @@
 // Loss and recovery, in lock-step (deterministic) and through the THREADED pipeline (fast), where
-// the track stage uses the mapper and relocalizer itself after MapperFence::waitForMapper()
-// (pipeline/odometry/mapper_fence.h): blank frames in the middle of a sequence lose tracking; the
+// the track stage relocalizes after MapperFence::waitForMapper() (pipeline/odometry/mapper_fence.h)
+// and asks the map stage for a new map: blank frames in the middle of a sequence lose tracking; the
 // system marks them lost, relocalizes against its stored keyframes when real frames return, and
 // goes on; frames of another scene start a new map segment. Every run must finish (no dead lock)
-// and account for every frame.
+// and account for every frame, and fast mode must write lock-step's bytes.
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <thread>
+
 #include "tests/support/odometry_run.h"
+#include "tests/support/same_trajectory.h"
 
 namespace plumb::test {
 namespace {
@@ -54,8 +58,7 @@ class OdometryRecovery : public ::testing::TestWithParam<runtime::RunMode> {
     EXPECT_TRUE(r.status.ok()) << r.status.message();
     return r;
   }
-  // Threaded runs track against the newest published map, not exactly the lock-step one.
-  double ateBound() const { return GetParam() == runtime::RunMode::kDeterministic ? 0.02 : 0.03; }
+  double ateBound() const { return 0.02; }
 };
 
 TEST_P(OdometryRecovery, RelocalizesAfterBlankFramesAndMarksThemLost) {
@@ -90,6 +93,36 @@ TEST_P(OdometryRecovery, NewMapSegmentWhenRelocalizationKeepsFailing) {
   EXPECT_EQ(r.stats.segments, 2u);
   EXPECT_LE(r.stats.frames_lost, uint64_t(options.odometry.relocalizer.max_lost_frames_before_new_map));
   EXPECT_GT(r.stats.frames_ok, uint64_t(kFirst + kSecond - 15));
+}
+
+// Every phase of the tracking state machine in one sequence (start a map, track, lost after blank
+// frames, relocalize, lost in another scene, a new map segment): fast mode, its map stage made slow,
+// writes lock-step's bytes. The new maps are built by the map stage from the tracker's request.
+TEST(OdometryRecoveryBytes, FastWritesLockStepsBytesThroughLossRelocalizationAndANewSegment) {
+  constexpr int kFirst = 80, kBlankBegin = 40, kBlankEnd = 46, kSecond = 40;
+  std::unique_ptr<SyntheticScene> a, b;
+  ASSERT_TRUE(SyntheticScene::create(noisySynth("textured", kFirst), &a).ok());
+  SynthOptions other = noisySynth("low_texture", kSecond);
+  other.seed = 7;
+  ASSERT_TRUE(SyntheticScene::create(other, &b).ok());
+  ScriptedSource lock_step_source(*a, b.get(), kFirst, kFirst + kSecond, kBlankBegin, kBlankEnd);
+  const OdometryRun lock_step = runOdometry(lock_step_source, systemOptions(true));
+  ASSERT_TRUE(lock_step.status.ok()) << lock_step.status.message();
+  ASSERT_GE(lock_step.stats.relocalizations, 1u);
+  ASSERT_EQ(lock_step.stats.segments, 2u);
+
+  ScriptedSource fast_source(*a, b.get(), kFirst, kFirst + kSecond, kBlankBegin, kBlankEnd);
+  RunSettings slow;
+  slow.mode = runtime::RunMode::kFast;
+  slow.on_frame = [](const FrameOutput& out) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(out.keyframe ? 4 : 1));
+  };
+  const OdometryRun fast = runOdometry(fast_source, systemOptions(true), slow);
+  ASSERT_TRUE(fast.status.ok()) << fast.status.message();
+  EXPECT_TRUE(sameTrajectory(fast.trajectory, lock_step.trajectory));
+  EXPECT_TRUE(sameTrajectory(fast.optimized, lock_step.optimized));
+  EXPECT_EQ(fast.stats.relocalizations, lock_step.stats.relocalizations);
+  EXPECT_EQ(fast.stats.segments, lock_step.stats.segments);
 }
 
 INSTANTIATE_TEST_SUITE_P(Modes, OdometryRecovery,

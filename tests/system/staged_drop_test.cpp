@@ -54,8 +54,6 @@ void runWithSlowMapStage(DropRun* run) {
   ASSERT_TRUE(SyntheticSource::create(synth, &source).ok());
   for (int i = 0; i < kFrames; ++i) run->source_timestamps.push_back(source->scene().timestamp(i));
 
-  std::unique_ptr<OdometrySystem> system;
-  ASSERT_TRUE(OdometrySystem::create(source->camera(), SystemOptions{}, &system).ok());
   runtime::VirtualClock clock;
   OdometryRunOptions options;
   options.schedule.mode = runtime::RunMode::kRealtime;
@@ -63,7 +61,7 @@ void runWithSlowMapStage(DropRun* run) {
   options.schedule.slot_count = 4;
   SlowOnceSink sink(clock, run);
   SourceCapture capture(*source);
-  const Status status = runOdometry(capture, *system, sink, options, &run->result);
+  const Status status = runOdometry(capture, SystemOptions{}, sink, options, &run->result);
   ASSERT_TRUE(status.ok()) << status.message();
 }
 

@@ -379,6 +379,24 @@ class LayerCheckTest(unittest.TestCase):
         self.append("drivers/CMakeLists.txt", "target_sources(plumb_drivers PRIVATE ${FROM_ELSEWHERE})\n")
         self.expect_only("drivers/CMakeLists.txt:8:", "${FROM_ELSEWHERE}", "cannot see")
 
+    def test_product_includes_the_viewer(self):
+        # viewer/ sits on pipeline/run and drivers; the run must never depend on a viewer.
+        self.append("viewer/live_view.h", '#include "pipeline/run/runner.h"\n')
+        self.append("pipeline/run/runner.cpp", '#include "viewer/live_view.h"\n')
+        self.expect_only("pipeline/run/runner.cpp:", "pipeline/run/ must not include viewer/")
+
+    def test_viewer_headers_outside_the_viewer(self):
+        self.append("drivers/dataset/tum.cpp", "#include <websocketpp/server.hpp>\n")
+        self.expect_only("drivers/dataset/tum.cpp:3:", "websocketpp")
+
+    def test_generated_source_belongs_to_its_folder(self):
+        # The viewer's embedded page is generated into the build tree: it counts as a file of the
+        # folder whose CMakeLists.txt makes it (drivers/ here), which may compile it.
+        self.append("drivers/CMakeLists.txt",
+                    "target_sources(plumb_drivers PRIVATE ${CMAKE_CURRENT_BINARY_DIR}/page.cpp)\n")
+        code, lines, stderr = run_checker(self.root)
+        self.assertEqual(code, 0, "\n".join(lines) + stderr)
+
     def test_symbolic_link_into_another_layer(self):
         os.symlink(os.path.join(self.root, "drivers"),
                    os.path.join(self.root, "pipeline", "frontend", "devices"))

@@ -1,10 +1,11 @@
-#include "pipeline/loop/rigid_ransac.h"
+#include "solver/rigid_fit.h"
 
-#include <Eigen/SVD>
 #include <algorithm>
 #include <random>
 
-namespace plumb::loop {
+#include <Eigen/SVD>
+
+namespace plumb {
 
 bool rigidFitKabsch(const Eigen::Vector3d* from, const Eigen::Vector3d* to, const bool* flags, int n,
                     Eigen::Isometry3d* T_to_from) {
@@ -80,4 +81,4 @@ int rigidRansac(const Eigen::Vector3d* from, const Eigen::Vector3d* to, int n,
   return countInliers(from, to, n, best_T, options.inlier_threshold_m, inliers);
 }
 
-}  // namespace plumb::loop
+}  // namespace plumb

@@ -1,14 +1,19 @@
 #pragma once
-// Rigid 3D-3D RANSAC over minimal 3-point fits (both ends have depth), for loop verification.
-// Fixed-size maths only (Kabsch on 3x3 matrices): no heap allocation. Deterministic: the sampler
-// is seeded from the options on every call. The relocalizer (pipeline/odometry/relocalizer.cpp)
-// keeps its own copy of the same scheme; its refit uses Eigen::umeyama on dynamic matrices, and
-// sharing this one would change its numerics (and so every trajectory that relocalizes).
-#include <Eigen/Core>
-#include <Eigen/Geometry>
+// Rigid (rotation + translation, no scale) 3D-3D fits, the one implementation for the whole tree:
+//   rigidFitKabsch  least squares over point pairs (Kabsch / Horn / Umeyama without scale: the SVD
+//                   of the 3x3 cross-covariance with the reflection guard), e.g. the ATE alignment
+//                   of drivers/trajectory/rigid_alignment.cpp (the TUM benchmark's evaluate_ate);
+//   rigidRansac     RANSAC over minimal 3-point fits refitted on the inliers, for matched points
+//                   that both have depth: loop verification (pipeline/loop/loop_verifier.cpp) and
+//                   relocalization (pipeline/odometry/relocalizer.cpp).
+// Fixed-size maths only: no heap allocation. Deterministic: the sampler is seeded from the options
+// on every call.
 #include <cstdint>
 
-namespace plumb::loop {
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace plumb {
 
 struct RigidRansacOptions {
   int iterations = 200;
@@ -28,4 +33,4 @@ int rigidRansac(const Eigen::Vector3d* from, const Eigen::Vector3d* to, int n,
                 const RigidRansacOptions& options, bool* scratch, bool* inliers,
                 Eigen::Isometry3d* T_to_from);
 
-}  // namespace plumb::loop
+}  // namespace plumb

@@ -1,0 +1,128 @@
+// The fast paths of the solvers' inner loops against straightforward Eigen references written
+// from their definitions: the stereo point-space blocks (solver/point_space_blocks.h), the pose
+// block lifted from them, and the small kernels of the landmark elimination
+// (solver/schur_kernels.h; its diagonal-block variant writes the lower triangle only). They
+// compute the same sums in another order, so the comparisons are to a relative 1e-12, which any
+// wrong index or sign misses by far.
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "solver/factors.h"
+#include "solver/point_space_blocks.h"
+#include "solver/schur_kernels.h"
+#include "solver/se3.h"
+
+namespace plumb {
+namespace {
+
+constexpr double kTolerance = 1e-12;
+
+template <typename A, typename B>
+double relativeError(const A& got, const B& expected) {
+  return (got - expected).norm() / std::max(1.0, expected.norm());
+}
+
+Eigen::Matrix3d randomInformation(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::Matrix3d A;
+  for (int i = 0; i < 9; ++i) A(i) = u(rng);
+  return A * A.transpose() + 0.1 * Eigen::Matrix3d::Identity();  // symmetric positive definite
+}
+
+TEST(SolverKernels, StereoPointSpaceBlocksEqualJtWJ) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const CameraIntrinsics camera{525.0, 523.0, 319.5, 239.5, 40.0};
+  for (int n = 0; n < 500; ++n) {
+    const Eigen::Vector3d P_cam(2.0 * u(rng), 1.5 * u(rng), 2.5 + 2.0 * u(rng));
+    const Eigen::Vector3d z(300 + 100 * u(rng), 200 + 100 * u(rng), 290 + 100 * u(rng));
+    Eigen::Vector3d e;
+    Eigen::Matrix3d J_cam;
+    stereoResidualAt(camera, P_cam, z, &e, &J_cam);
+    const Eigen::Matrix3d omega = randomInformation(rng);
+    const double weight = 0.5 + 0.5 * u(rng);
+    Eigen::Matrix3d M;
+    Eigen::Vector3d q;
+    stereoPointSpaceBlocks(J_cam, omega, omega * e, weight, &M, &q);
+    const Eigen::Matrix3d M_expected = J_cam.transpose() * (weight * omega) * J_cam;
+    const Eigen::Vector3d q_expected = J_cam.transpose() * (weight * omega) * e;
+    ASSERT_LT(relativeError(M, M_expected), kTolerance) << n;
+    ASSERT_LT(relativeError(q, q_expected), kTolerance) << n;
+    // The general path agrees too (it is what mono points still use).
+    Eigen::Matrix3d M_general;
+    Eigen::Vector3d q_general;
+    pointSpaceBlocks<3>(J_cam, Eigen::Matrix3d(weight * omega), e, &M_general, &q_general);
+    ASSERT_LT(relativeError(M_general, M_expected), kTolerance) << n;
+    ASSERT_LT(relativeError(q_general, q_expected), kTolerance) << n;
+  }
+}
+
+TEST(SolverKernels, PoseNormalAccumulatorEqualsLiftedJacobianProducts) {
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  PoseNormalAccumulator accumulator;
+  Matrix6d H_expected = Matrix6d::Zero();
+  Vector6d g_expected = Vector6d::Zero();
+  for (int n = 0; n < 50; ++n) {
+    const Eigen::Vector3d P(u(rng), u(rng), 2.0 + u(rng));
+    const Eigen::Matrix3d M = randomInformation(rng);
+    const Eigen::Vector3d q(u(rng), u(rng), u(rng));
+    accumulator.add(M, q, P);
+    const Matrix36d A = pointPoseJacobian(P);  // [I | -[P]x]
+    H_expected += A.transpose() * M * A;
+    g_expected += A.transpose() * q;
+  }
+  Matrix6d H;
+  Vector6d g;
+  accumulator.finish(&H, &g);
+  EXPECT_LT(relativeError(H, H_expected), kTolerance);
+  EXPECT_LT(relativeError(g, g_expected), kTolerance);
+}
+
+TEST(SolverKernels, SchurBlockKernelsEqualEigenProducts) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int n = 0; n < 200; ++n) {
+    Matrix63d W, V_in;
+    for (int i = 0; i < 18; ++i) W(i) = u(rng), V_in(i) = u(rng);
+    const Eigen::Matrix3d H = randomInformation(rng);
+    const Eigen::Vector3d g(u(rng), u(rng), u(rng));
+    Vector6d rhs;
+    for (int i = 0; i < 6; ++i) rhs(i) = u(rng);
+    const Vector6d rhs_expected = rhs + W * H * g;
+    Matrix63d V;
+    formVAndRhs(W, H, g, &V, rhs.data());
+    ASSERT_LT(relativeError(V, Matrix63d(W * H)), kTolerance) << n;
+    ASSERT_LT(relativeError(rhs, rhs_expected), kTolerance) << n;
+
+    // A 6x6 block inside a larger column-major matrix (odd offset and stride): only the block
+    // changes.
+    Eigen::MatrixXd S = Eigen::MatrixXd::Random(20, 17);
+    const Eigen::MatrixXd before = S;
+    subtractVWt(V_in, W, &S(3, 5), S.outerStride());
+    Eigen::MatrixXd expected = before;
+    expected.block<6, 6>(3, 5) -= V_in * W.transpose();
+    ASSERT_LT(relativeError(S, expected), kTolerance) << n;
+    Eigen::MatrixXd outside = S - before;
+    outside.block<6, 6>(3, 5).setZero();
+    ASSERT_EQ(outside.cwiseAbs().maxCoeff(), 0.0) << n;
+
+    // The diagonal-block variant: the lower triangle bit-identical to the full kernel's, the
+    // strict upper triangle beyond the 2x2 pairs on the diagonal untouched.
+    Eigen::MatrixXd lower = before;
+    subtractVWtLower(V_in, W, &lower(3, 5), lower.outerStride());
+    for (int c = 0; c < 6; ++c) {
+      for (int r = 0; r < 6; ++r) {
+        if (r >= c) {
+          ASSERT_EQ(lower(3 + r, 5 + c), S(3 + r, 5 + c)) << n << " " << r << " " << c;
+        } else if (r < (c & ~1)) {
+          ASSERT_EQ(lower(3 + r, 5 + c), before(3 + r, 5 + c)) << n << " " << r << " " << c;
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace plumb
