@@ -24,6 +24,12 @@ class ImagePyramid {
 
   // grey: CV_8UC1 of the level-0 size. Fills every level and the blurred levels.
   void build(const cv::Mat& grey);
+  // Fills the levels only; blurRect() then blurs just the parts a caller reads (ORB blurs the
+  // neighbourhoods of the keypoints it describes: ~half of the pixels on fr1/rpy). A blurred
+  // pixel has the same value either way; pixels never blurred keep older contents.
+  void buildLevels(const cv::Mat& grey);
+  // Blurs [x0, x1) x [y0, y1) of `level` (clipped to the level) into blurred(level).
+  void blurRect(int level, int x0, int y0, int x1, int y1);
 
   int numLevels() const { return num_levels_; }
   float scale(int level) const { return scales_[level]; }  // scale_factor^level
@@ -34,7 +40,9 @@ class ImagePyramid {
  private:
   int num_levels_;
   std::array<float, kPyramidLevels> scales_{};
-  void blur(const cv::Mat& src, cv::Mat& dst);
+  // The separable 7-tap blur of src on [x0, x1) x [y0, y1) into dst, borders reflected at the
+  // image edges (not at the rectangle's): every pixel gets the value a whole-image pass gives.
+  void blur(const cv::Mat& src, cv::Mat& dst, int x0, int y0, int x1, int y1);
   void downsample(int level);  // levels_[level - 1] -> levels_[level], bilinear
 
   // Bilinear sampling table of one axis of one level: source index and the 11-bit fixed-point
