@@ -65,6 +65,31 @@ inline void subtractVWtLower(const Matrix63d& V, const Matrix63d& W, double* S, 
   }
 }
 
+// S_block -= gamma x y^T (x, y: 6 doubles), the rank-one form of V W^T for line samples.
+inline void subtractScaledOuter(double gamma, const double* x, const double* y, double* S, Eigen::Index stride) {
+  using namespace schur_detail;
+  const Double2 x0 = load2(x), x1 = load2(x + 2), x2 = load2(x + 4);
+  for (int c = 0; c < 6; ++c, S += stride) {
+    const Double2 s = splat(gamma * y[c]);
+    store2(S, load2(S) - x0 * s);
+    store2(S + 2, load2(S + 2) - x1 * s);
+    store2(S + 4, load2(S + 4) - x2 * s);
+  }
+}
+
+// The same on a diagonal block, lower triangle only (row pairs from (c & ~1) down, as
+// subtractVWtLower).
+inline void subtractScaledOuterLower(double gamma, const double* x, const double* y, double* S, Eigen::Index stride) {
+  using namespace schur_detail;
+  const Double2 x0 = load2(x), x1 = load2(x + 2), x2 = load2(x + 4);
+  for (int c = 0; c < 6; ++c, S += stride) {
+    const Double2 s = splat(gamma * y[c]);
+    if (c < 2) store2(S, load2(S) - x0 * s);
+    if (c < 4) store2(S + 2, load2(S + 2) - x1 * s);
+    store2(S + 4, load2(S + 4) - x2 * s);
+  }
+}
+
 // V = W H (W 6x3, H 3x3) and rhs += V g (rhs: 6 doubles).
 inline void formVAndRhs(const Matrix63d& W, const Eigen::Matrix3d& H, const Eigen::Vector3d& g, Matrix63d* V,
                         double* rhs) {
