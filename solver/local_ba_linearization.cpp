@@ -145,20 +145,33 @@ double LocalBundleAdjuster::linearize(const LocalBaOptions& options) {
           break;
         }
         case ObservationKind::kLineSample:
-        default: {  // (the enum has no other value; keeps M and q visibly assigned)
+        default: {  // (the enum has no other value)
+          // Rank one: with j = J_cam^T and c = w Omega, M = c j j^T, so every block is an outer
+          // product: R^T M R = c r r^T (r = R^T j), W = A^T M R = u r^T (u = c A^T j =
+          // c [j; P_cam x j]) and A^T M A = u (A^T j)^T, about half the work of the 3x3 forms.
           double e = 0.0;
           Eigen::RowVector3d J_cam;
           lineResidualAt(camera_, P_cam, obs.z, &e, &J_cam);
           obs.chi2 = e * e * obs.information(0, 0);
           k = evaluateKernel(kernel, obs.chi2);
-          const Eigen::Vector3d wj = (k.rho1 * obs.information(0, 0)) * J_cam.transpose();
-          M.noalias() = wj * J_cam;  // rank one
-          q = e * wj;
-          // The rank-one factors of W = u r^T for the elimination (Observation::V).
-          obs.V.col(0).head<3>() = wj;
-          obs.V.col(0).tail<3>() = P_cam.cross(wj);
-          obs.V.col(1).head<3>().noalias() = kf.T_cam_world.linear().transpose() * J_cam.transpose();
-          break;
+          cost += 0.5 * k.rho;
+          obs.valid = true;
+          obs.outlier = false;
+          const double c = k.rho1 * obs.information(0, 0);
+          const Eigen::Vector3d j = J_cam.transpose();
+          const Eigen::Vector3d r = kf.T_cam_world.linear().transpose() * j;
+          const Eigen::Vector3d cr = c * r;
+          lm.H_point.noalias() += cr * r.transpose();
+          lm.g_point += e * cr;
+          if (kf.variable < 0) continue;
+          Vector6d A_t_j;
+          A_t_j << j, P_cam.cross(j);
+          const Vector6d u = c * A_t_j;
+          kf.normal.addRankOne(u, A_t_j, e * u);
+          for (int col = 0; col < 3; ++col) obs.W.col(col) = u * r(col);
+          obs.V.col(0) = u;  // the factors of W for the elimination (Observation::V)
+          obs.V.col(1).head<3>() = r;
+          continue;
         }
       }
       cost += 0.5 * k.rho;
