@@ -8,7 +8,46 @@
 #include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
+// Byte shuffles for downsample(): SSSE3's pshufb (x86-64, chosen at run time: the baseline is
+// SSE2) or NEON's tbl (every aarch64 CPU). Elsewhere the portable gather path alone.
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <tmmintrin.h>
+#define PLUMB_PYRAMID_SHUFFLE 1
+#define PLUMB_PYRAMID_SHUFFLE_TARGET __attribute__((target("ssse3")))
+#elif defined(__aarch64__)
+#include <arm_neon.h>
+#define PLUMB_PYRAMID_SHUFFLE 1
+#define PLUMB_PYRAMID_SHUFFLE_TARGET
+#else
+#define PLUMB_PYRAMID_SHUFFLE 0
+#endif
+
 namespace plumb {
+#if PLUMB_PYRAMID_SHUFFLE
+namespace {
+
+// 16 bytes at `row`, permuted: byte i of the result is byte shuffle[i] of the input (< 16).
+PLUMB_PYRAMID_SHUFFLE_TARGET inline cv::v_int16x8 shuffleBytes(const int16_t* row, const uint8_t* shuffle) {
+#if defined(__x86_64__)
+  const __m128i bytes = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row));
+  return cv::v_int16x8(_mm_shuffle_epi8(bytes, _mm_loadu_si128(reinterpret_cast<const __m128i*>(shuffle))));
+#else
+  const uint8x16_t bytes = vld1q_u8(reinterpret_cast<const uint8_t*>(row));
+  return cv::v_int16x8(vreinterpretq_s16_u8(vqtbl1q_u8(bytes, vld1q_u8(shuffle))));
+#endif
+}
+
+bool cpuHasShuffle() {
+#if defined(__x86_64__)
+  static const bool has = __builtin_cpu_supports("ssse3");
+  return has;
+#else
+  return true;
+#endif
+}
+
+}  // namespace
+#endif
 
 ImagePyramid::ImagePyramid(int width, int height, int num_levels, float scale_factor)
     : num_levels_(num_levels < 1 ? 1 : (num_levels > kPyramidLevels ? kPyramidLevels : num_levels)) {
@@ -35,6 +74,20 @@ ImagePyramid::ImagePyramid(int width, int height, int num_levels, float scale_fa
     // downsample() reads the pair (index0, index0 + 1): index1 may differ only with weight 0.
     CV_Assert(t.index1 == t.index0 + 1 || t.weight == 0);
     x_weight_pairs_.push_back(((1 << kWeightBits) - t.weight) | (t.weight << 16));
+  }
+  for (int i = 1; i < num_levels_; ++i) {
+    group_start_[i] = static_cast<int>(group_base_.size());
+    shuffle_ok_[i] = true;
+    const Tap* taps = x_taps_.data() + x_tap_start_[i];
+    for (int g = 0; g < 2 * (sizes[i].width / 8); ++g) {  // the vector loop's blocks of 8
+      const int base = taps[4 * g].index0;
+      group_base_.push_back(base);
+      for (int j = 0; j < 4; ++j) {
+        const int offset = taps[4 * g + j].index0 - base;  // element pair (offset, offset + 1)
+        if (offset < 0 || offset > 6) shuffle_ok_[i] = false;
+        for (int b = 0; b < 4; ++b) group_shuffle_.push_back(static_cast<uint8_t>(std::clamp(2 * offset + b, 0, 15)));
+      }
+    }
   }
   const cv::Mat kernel = cv::getGaussianKernel(7, 2.0, CV_64F);
   int sum = 0;
@@ -73,6 +126,35 @@ void ImagePyramid::buildLevels(const cv::Mat& grey) {
 void ImagePyramid::blurRect(int level, int x0, int y0, int x1, int y1) {
   blur(levels_[level], blurred_levels_[level], x0, y0, x1, y1);
 }
+
+#if PLUMB_PYRAMID_SHUFFLE
+namespace {
+
+// The horizontal pass of downsample() on whole blocks of 8 outputs, gathering the (x0, x0 + 1)
+// pairs by byte shuffles; the same integer arithmetic, so the same bytes. Returns the first
+// output column it did not write.
+PLUMB_PYRAMID_SHUFFLE_TARGET int horizontalShuffled(const int16_t* high, const int16_t* low, const int32_t* bases,
+                                                    const uint8_t* shuffles, const int32_t* weights, int cols,
+                                                    uint8_t* d) {
+  const cv::v_int32x4 round = cv::v_setall_s32(1 << 21);
+  int xd = 0;
+  for (int g = 0; xd + 8 <= cols; xd += 8, g += 2) {
+    cv::v_int32x4 sums[2];
+    for (int h = 0; h < 2; ++h) {
+      const int base = bases[g + h];
+      const uint8_t* shuffle = shuffles + 16 * (g + h);
+      const cv::v_int16x8 high_pairs = shuffleBytes(high + base, shuffle);
+      const cv::v_int16x8 low_pairs = shuffleBytes(low + base, shuffle);
+      const cv::v_int16x8 w = cv::v_reinterpret_as_s16(cv::v_load(weights + xd + 4 * h));
+      sums[h] = ((cv::v_dotprod(high_pairs, w) << 10) + cv::v_dotprod(low_pairs, w) + round) >> 22;
+    }
+    cv::v_pack_u_store(d + xd, cv::v_pack(sums[0], sums[1]));
+  }
+  return xd;
+}
+
+}  // namespace
+#endif
 
 void ImagePyramid::appendTaps(int src_size, int dst_size, std::vector<Tap>& taps) {
   const double step = static_cast<double>(src_size) / dst_size;
@@ -136,6 +218,12 @@ void ImagePyramid::downsample(int level) {
     // padding element past the row only ever meets a zero weight.
     uint8_t* d = dst.ptr<uint8_t>(y);
     int xd = 0;
+#if PLUMB_PYRAMID_SHUFFLE
+    if (shuffle_ok_[level] && cpuHasShuffle()) {
+      xd = horizontalShuffled(high, low, group_base_.data() + group_start_[level],
+                              group_shuffle_.data() + 16 * group_start_[level], x_weights, dst.cols, d);
+    }
+#endif
     for (; xd + 8 <= dst.cols; xd += 8) {
       cv::v_int32x4 sums[2];
       for (int g = 0; g < 2; ++g) {

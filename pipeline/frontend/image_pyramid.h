@@ -36,6 +36,8 @@ class ImagePyramid {
   const cv::Mat& level(int i) const { return levels_[i]; }
   const cv::Mat& blurred(int i) const { return blurred_levels_[i]; }
   int stride() const { return static_cast<int>(buffer_.step[0]); }  // bytes per row, every level
+  // Whether downsample() can gather level i's bilinear pairs by byte shuffles (tests).
+  bool shuffleGatherPossible(int level) const { return shuffle_ok_[level]; }
 
  private:
   int num_levels_;
@@ -58,6 +60,15 @@ class ImagePyramid {
   std::array<int, kPyramidLevels> x_tap_start_{}, y_tap_start_{};  // each level's first entry
   std::vector<int32_t> x_weight_pairs_;  // per x tap: (2048 - weight) | weight << 16, two int16 lanes
   cv::Mat high_row_, low_row_;      // CV_16SC1, one source row + padding: the vertical pass, split
+  // Byte-shuffle form of the horizontal pass (x86-64 with SSSE3, aarch64): the four (x0, x0 + 1)
+  // pairs of 4 consecutive outputs lie within 8 source elements (scale 1.2: ~5.8), so one 16-byte
+  // load at the group's first index0 and one byte shuffle replace 4 scalar loads. Per group of 4
+  // outputs of the vector loop: that index and the shuffle's 16 byte indices. shuffle_ok_ is
+  // false for a level whose taps spread further (larger scale factors): the scalar-gather path.
+  std::vector<int32_t> group_base_;
+  std::vector<uint8_t> group_shuffle_;
+  std::array<int, kPyramidLevels> group_start_{};
+  std::array<bool, kPyramidLevels> shuffle_ok_{};
 
   cv::Mat buffer_, blurred_buffer_;
   cv::Mat row_filtered_;            // CV_16UC1, one row + 3 px padding each side: the blur's vertical pass

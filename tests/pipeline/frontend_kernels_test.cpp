@@ -106,6 +106,21 @@ TEST(FrontendKernels, PyramidEqualsExactBilinearAndFixedPointBlur) {
   EXPECT_EQ(pyramid.level(7).cols, static_cast<int>(std::lround(643 / std::pow(1.2f, 7.f))));
 }
 
+TEST(FrontendKernels, PyramidEqualsExactBilinearWithAndWithoutShuffleGather) {
+  // Scale 1.2 (the default) and 1.5 take the byte-shuffle gather on x86-64 with SSSE3 and on
+  // aarch64; 2.5 spreads 4 outputs over more than 8 source pixels and takes the portable path.
+  const cv::Mat img = testImage(517, 389, 14);
+  for (const float scale : {1.2f, 1.5f, 2.5f}) {
+    ImagePyramid pyramid(img.cols, img.rows, 4, scale);
+    pyramid.buildLevels(img);
+    for (int i = 1; i < pyramid.numLevels(); ++i) {
+      EXPECT_EQ(pyramid.shuffleGatherPossible(i), scale < 2.0f) << "scale " << scale << " level " << i;
+      const cv::Mat expected = referenceDownsample(pyramid.level(i - 1), pyramid.level(i).size());
+      EXPECT_EQ(cv::norm(pyramid.level(i), expected, cv::NORM_INF), 0) << "scale " << scale << " level " << i;
+    }
+  }
+}
+
 TEST(FrontendKernels, BlurOfRectanglesEqualsTheWholeImageBlurInsideThem) {
   // ORB blurs only around its keypoints (ImagePyramid::blurRect): small, odd-sized rectangles
   // at the image edges and inside must get exactly the whole-image values, and nothing outside
