@@ -207,6 +207,7 @@ PoseResult optimizePose(const CameraIntrinsics& camera, const Eigen::Isometry3d&
     if (changed == 0) break;
   }
 
+  if (!options.compute_covariance) return result;
   const NormalEquations ne = linearize(camera, result.T_cam_world, points, num_points, lines, num_lines,
                                        kernels, point_inliers, line_inliers);
   result.final_cost = ne.cost;

@@ -95,8 +95,9 @@ class Tracker {
   int matchLocalMap(const FrameFeatures& frame, const Eigen::Isometry3d& T_cam_world);
   void clearAssociations(const FrameFeatures& frame);
   // tracker_pose.cpp: optimise from T_cam_world, drop outlier associations, count inliers.
+  // want_covariance = false: the result's covariance is invalid (one linearisation fewer).
   PoseResult optimizeAndPrune(const FrameFeatures& frame, const Eigen::Isometry3d& T_cam_world,
-                              TrackResult* result);
+                              TrackResult* result, bool want_covariance = true);
   // The tracked pose's published covariances (TrackResult) from the final optimisation.
   // twist_per_s: the frame's velocity (timing model error, UncertaintyOptions).
   void publishCovariance(const PoseResult& pose, const Vector6d& twist_per_s, TrackResult* result) const;
