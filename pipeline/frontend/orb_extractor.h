@@ -42,7 +42,7 @@ class OrbExtractor {
   void selectOnLevel(int level, int wanted, FrameFeatures& out);
   // Blurs the parts of `level` the descriptors of its first `take` ranked corners read.
   void blurAroundKeypoints(int level, int take);
-  static constexpr int kBlurTile = 16;  // px, square
+  static constexpr int kBlurTile = 8;  // px, square: 8 blurs ~7 % fewer pixels than 16 on fr1/rpy
 
   PinholeCamera camera_;
   ExtractorOptions options_;
