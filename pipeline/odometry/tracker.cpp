@@ -131,7 +131,7 @@ TrackResult Tracker::track(const FrameFeatures& input, uint64_t sequence, double
   Eigen::Isometry3d T_cam_world = T_cam_world_pred;
   if (matches >= 6) {
     // Only its pose and inliers are used (for the local-map search): no covariance.
-    const PoseResult pose = optimizeAndPrune(frame, T_cam_world_pred, &result, /*want_covariance=*/false);
+    const PoseResult pose = optimizeAndPrune(frame, T_cam_world_pred, &result, /*final_pose=*/false);
     T_cam_world = pose.T_cam_world;
   }
 
