@@ -1,5 +1,5 @@
 #pragma once
-// The two small products of the landmark elimination in local BA (local_ba_linearization.cpp),
+// The small products of the landmark elimination in local BA (local_ba_linearization.cpp),
 // written on 2-double vectors (GCC/Clang vector extensions: SSE2 on x86-64, NEON on aarch64).
 //
 // Why not Eigen's `S.block<6, 6>(..) -= V * W.transpose()`: GCC compiles it column by column and
