@@ -234,7 +234,7 @@ bool LocalBundleAdjuster::solveDamped(const LocalBaOptions& options, double lamb
     auto block = [&S](int row_variable, int col_variable) { return &S(6 * row_variable, 6 * col_variable); };
     if (all_line_samples) {
       // W_a = u_a r_a^T, so V_a W_b^T = u_a (r_a^T H_ll^-1 r_b) u_b^T: a scaled outer product of
-      // two 6-vectors (~40% of the general product's instructions); V g = u (H_ll^-1 r)^T g.
+      // two 6-vectors (about half the instructions of the general product); V g = u (H_ll^-1 r)^T g.
       for (int a = 0; a < num_free; ++a) {
         Observation& obs = observations_[free_obs[a]];
         obs.V.col(2).head<3>().noalias() = lm.H_point_inv * obs.V.col(1).head<3>();
