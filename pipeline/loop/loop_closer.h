@@ -17,7 +17,9 @@
 //      (S_j: edge covariances; drift_j: a prior proportional to the distance travelled.) Repeated
 //      texture typically implies a jump of a whole module that this test refuses.
 //   5. a loop edge (Huber kernel), pose-graph LM (solver/pose_graph.h), and a MapCorrection for
-//      the query keyframe (its optimised pose) for the mapping side.
+//      the query keyframe for the mapping side: its pose as the robot had it moved towards where
+//      the loop puts it relative to the candidate, by the minimum-variance share of the
+//      correction (fuse_realtime_correction; docs/LOOP.md "What the robot receives").
 // Lifelong bound: when `capacity` records are held, the most redundant keyframe (smallest distance
 // to its two graph neighbours; not the first, the newest, or one with a loop edge) is culled: its two
 // odometry edges are composed into one (covariances propagated), it leaves the database.
