@@ -12,7 +12,9 @@
 # udevd for libusb hot-plug events, every shared library ldd names) and boots it with
 # qemu-system-x86_64: KVM when /dev/kvm opens, TCG otherwise (at a lower frame rate). The guest
 # (scripts/vm_camera_guest.sh) runs the checks: vivid (+ every error-injection control),
-# v4l2loopback (live vs replay ATE, lost frames) and USB (dummy_hcd gadget, libusb, hot-plug). Its
+# v4l2loopback (live vs replay ATE, lost frames; with the USB check selected, the camera's USB
+# identity unplugged mid-run and plugged in again 2 s later) and USB (dummy_hcd gadget, libusb,
+# hot-plug, which virtual USB path carries UVC video). Its
 # report comes back over the serial console; the exit code is the guest's verdict.
 #
 # Environment:

@@ -128,6 +128,26 @@ void printSummary(const RunCommandOptions& o, const RunPlan& plan, const RunOutp
   }
 }
 
+// A supervised live source's outages, for --stats: how many, how long, and how soon a camera's
+// USB arrival brought frames back. "" for sources that are not supervised (replays).
+std::string supervisionJson(const FrameSource& source) {
+  SourceSupervision s;
+  if (!source.supervision(&s)) return "";
+  char text[640];
+  std::snprintf(text, sizeof text,
+                "{\"outages\": %llu, \"reconnects\": %llu, \"errors\": %llu, \"stall_timeouts\": %llu, "
+                "\"reopen_failures\": %llu, \"usb_departures\": %llu, \"usb_arrivals\": %llu,\n"
+                "    \"disconnected_s\": %.3f, \"longest_outage_s\": %.3f, \"arrival_to_first_frame_s\": %s, "
+                "\"frames_missing\": %llu, \"gaps\": %llu}",
+                (unsigned long long)s.outages, (unsigned long long)s.reconnects, (unsigned long long)s.errors,
+                (unsigned long long)s.stall_timeouts, (unsigned long long)s.reopen_failures,
+                (unsigned long long)s.usb_departures, (unsigned long long)s.usb_arrivals, s.disconnected_ns * 1e-9,
+                s.longest_outage_ns * 1e-9,
+                s.arrival_to_frame_ns < 0 ? "null" : std::to_string(s.arrival_to_frame_ns * 1e-9).c_str(),
+                (unsigned long long)s.frames_missing, (unsigned long long)s.gaps);
+  return text;
+}
+
 Status writeStats(const RunCommandOptions& o, const FlagTable& table, const RunPlan& plan, const RunOutputs& outputs,
                   const RunExecution& ex, const SourceDamage& damage, double ate, int stop_signal) {
   RunSummary summary;
@@ -152,6 +172,7 @@ Status writeStats(const RunCommandOptions& o, const FlagTable& table, const RunP
     summary.map_saved_keyframes = plan.saved_map.keyframes.size();
     summary.map_saved_bytes = ex.map_bytes;
   }
+  summary.source_supervision_json = supervisionJson(*plan.source);
   return writeFileAtomically(o.stats, runSummaryJson(summary));
 }
 

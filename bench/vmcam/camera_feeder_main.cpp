@@ -4,7 +4,7 @@
 //
 //   plumb_vmcam_feeder feed --source SPEC --colour DEV --depth DEV --out-dir DIR
 //                           [--fps F (10)] [--frames N (all)] [--gt FILE (SPEC/groundtruth.txt)]
-//                           [--hold 1] [--wait-for FILE]
+//                           [--hold 1] [--wait-for FILE] [--pause-while FILE]
 //   plumb_vmcam_feeder match --sent DIR/sent.txt --trajectory TRAJ [--received-out FILE]
 //   plumb_vmcam_feeder select --recording REC --indices FILE --out OUT
 //
@@ -23,7 +23,9 @@
 // The stamps of the replay and of groundtruth.txt are when the colour write() returned, within a
 // write's duration of the driver's own stamp. Every write has its own index in every output file:
 // --wait-for repeats frame 0 until the file exists, --hold 1 repeats the last frame after the
-// sequence until SIGTERM (which ends the feed cleanly).
+// sequence until SIGTERM (which ends the feed cleanly). --pause-while: while FILE exists nothing is
+// written (the camera is unplugged), but the schedule runs on and the frames due meanwhile are
+// never sent (the camera was moving): the bench's hot-plug check.
 // match: which sent frames the trajectory starts and ends at, and how many sent between them have
 // no trajectory line (lost on the way). Prints `first_frame K last_frame J live_frames M matched M
 // unmatched U restamped R lost L` (R: see the v4l2loopback REQBUFS quirk in match());
@@ -146,6 +148,8 @@ struct FeedOptions {
   // Send frame 0 (the first one makes the loopback devices capture devices) again and again until
   // this file exists: the reader then streams and sees the whole sequence, never starving before.
   std::string wait_for;
+  // While this file exists, write nothing and skip the frames due (an unplugged camera).
+  std::string pause_while;
 };
 
 // One frame as it goes out: YUYV colour and depth in millimetres, and its true pose if known.
@@ -228,13 +232,31 @@ Status feed(const FeedOptions& o) {
   // write, then (--hold) the last one until SIGTERM.
   std::size_t index = 0, frame = 0, first_view_writes = 0, last_view_writes = 0;
   bool started = o.wait_for.empty(), summarised = false;
-  for (; !frames.empty() && g_stop_requested == 0; ++index) {
-    const OutgoingFrame& f = frames[frame];
+  std::size_t pauses = 0, frames_not_sent = 0;
+  while (!frames.empty() && g_stop_requested == 0) {
     // Absolute schedule: no drift; a late frame goes at once and is counted.
     timespec due{time_t(due_ns / 1000000000), long(due_ns % 1000000000)};
     clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &due, nullptr);
     late_ns = std::max(late_ns, monotonicNs() - due_ns);
     due_ns += period_ns;
+    const auto unplugged = [&] { return started && !o.pause_while.empty() && std::ifstream(o.pause_while).good(); };
+    if (unplugged()) {
+      // Nothing is written while unplugged, and the frames due meanwhile are never sent (the camera
+      // moved on). Polled every 10 ms: once plugged in again the camera streams at once (so the
+      // frame a reader that reopens first takes is a new one, not the last one before the outage).
+      ++pauses;
+      ++frames_not_sent;  // the frame due now
+      if (frame + 1 < frames.size()) ++frame;
+      for (; unplugged() && g_stop_requested == 0; usleep(10000)) {
+        for (; monotonicNs() >= due_ns; due_ns += period_ns) {
+          ++frames_not_sent;
+          if (frame + 1 < frames.size()) ++frame;
+        }
+      }
+      due_ns = monotonicNs();
+      continue;
+    }
+    const OutgoingFrame& f = frames[frame];
     // Colour and depth are written at the same time, from two threads, like a camera whose
     // sensors are synchronised: their stamps differ by little more than the two copies do.
     int64_t t_colour_start = 0, t_colour = 0, t_depth_start = 0, t_depth = 0;
@@ -259,6 +281,7 @@ Status feed(const FeedOptions& o) {
     decoded.t_sensor_ns = t_colour;
     decoded.depth_factor = 1000.0;
     PLUMB_RETURN_IF_ERROR(replay->append(decoded));
+    ++index;
     if (f.has_truth) {
       plumb::StampedPose pose = f.truth;
       pose.timestamp = t_colour * 1e-9;
@@ -291,6 +314,7 @@ Status feed(const FeedOptions& o) {
   PLUMB_RETURN_IF_ERROR(replay->close());
   if (!truth.empty()) PLUMB_RETURN_IF_ERROR(plumb::writeTumTrajectory(o.out_dir + "/groundtruth.txt", truth));
   if (last_view_writes > 0) std::printf("feeder: then %zu frames of the last view\n", last_view_writes);
+  if (pauses > 0) std::printf("feeder: paused %zu time(s) (unplugged): %zu frame(s) never sent\n", pauses, frames_not_sent);
   return Status::Ok();
 }
 
@@ -429,6 +453,7 @@ int main(int argc, char** argv) {
     else if (key == "--gt") feed_options.gt = value;
     else if (key == "--hold") feed_options.hold = value == "1";
     else if (key == "--wait-for") feed_options.wait_for = value;
+    else if (key == "--pause-while") feed_options.pause_while = value;
     else if (key == "--sent") sent = value;
     else if (key == "--trajectory") trajectory = value;
     else if (key == "--received-out") received_out = value;
@@ -451,7 +476,8 @@ int main(int argc, char** argv) {
   if (command == "select" && !recording.empty() && !indices.empty() && !out.empty())
     return select(recording, indices, out);
   std::fprintf(stderr,
-               "usage: %s feed --source SPEC --colour DEV --depth DEV --out-dir DIR [--fps F] [--frames N]\n"
+               "usage: %s feed --source SPEC --colour DEV --depth DEV --out-dir DIR [--fps F] [--frames N] [--hold 1]\n"
+               "                [--wait-for FILE] [--pause-while FILE]\n"
                "       %s match --sent FILE --trajectory FILE [--received-out FILE]\n"
                "       %s select --recording FILE --indices FILE --out FILE\n",
                argv[0], argv[0], argv[0]);

@@ -30,6 +30,20 @@ struct SourceDamage {
   bool any() const { return regions_skipped > 0 || truncated_tail_bytes > 0 || !closed_properly; }
 };
 
+// What supervision of a live source counted (drivers/fault/resilient_source.h), for statistics.
+struct SourceSupervision {
+  uint64_t errors = 0, stall_timeouts = 0, reconnects = 0, reopen_failures = 0;
+  uint64_t outages = 0;                // failures (errors, stalls, departures) that needed a reopen
+  uint64_t usb_departures = 0;         // the camera left the bus (libusb), counted once per outage
+  uint64_t usb_arrivals = 0;           // arrivals that ended a wait or a backoff (hot-plug wake-ups)
+  uint64_t frames_missing = 0, gaps = 0;
+  int64_t disconnected_ns = 0;         // summed over the outages
+  int64_t longest_outage_ns = 0;       // failure -> successful reopen, the longest one
+  // The last reconnection an arrival woke: arrival event -> first frame delivered after it
+  // (-1: none). Tracking that frame takes the run's per-frame time on top.
+  int64_t arrival_to_frame_ns = -1;
+};
+
 class FrameSource {
  public:
   virtual ~FrameSource() = default;
@@ -54,6 +68,18 @@ class FrameSource {
   // A flag the caller sets to end the run (SIGINT): a live source that blocks (reconnecting with
   // backoff) checks it and returns kNoFrame soon after. nullptr = none. Wrappers forward it.
   virtual void setStopFlag(const std::atomic<bool>* stop) { (void)stop; }
+  // Hot-plug hints, from any thread (the libusb listener, drivers/usb/usb_arrival_waker.h).
+  // wakeReconnect: the camera arrived: a live source waiting to reconnect tries now rather than
+  // after its backoff. deviceLeft: the camera left the bus: a supervised source reports the
+  // disconnect at once (without waiting for errors or its stall timeout) and reopens only once
+  // it arrives again. Wrappers forward both.
+  virtual void wakeReconnect() {}
+  virtual void deviceLeft() {}
+  // Supervised live sources: the outages for `plumb run --stats` (false: not supervised).
+  virtual bool supervision(SourceSupervision* out) const {
+    (void)out;
+    return false;
+  }
 };
 
 }  // namespace plumb

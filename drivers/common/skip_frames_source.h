@@ -7,13 +7,13 @@
 #include <cstdint>
 #include <memory>
 
-#include "drivers/common/frame_source.h"
+#include "drivers/common/forwarding_source.h"
 
 namespace plumb {
 
-class SkipFramesSource : public FrameSource {
+class SkipFramesSource : public ForwardingSource {
  public:
-  SkipFramesSource(std::unique_ptr<FrameSource> inner, uint64_t skip) : inner_(std::move(inner)), skip_(skip) {}
+  SkipFramesSource(std::unique_ptr<FrameSource> inner, uint64_t skip) : ForwardingSource(std::move(inner)), skip_(skip) {}
 
   SourceResult next(RgbdImage& out) override {
     // A source that knows its length ends at once when everything is skipped: nothing is read,
@@ -28,21 +28,13 @@ class SkipFramesSource : public FrameSource {
     }
     return inner_->next(out);
   }
-  const PinholeCamera& camera() const override { return inner_->camera(); }
   std::string describe() const override { return inner_->describe() + " from frame " + std::to_string(skip_); }
-  const Status& lastError() const override { return inner_->lastError(); }
-  Status reopen() override { return inner_->reopen(); }
-  bool isLive() const override { return inner_->isLive(); }
   std::size_t frameCount() const override {
     const std::size_t n = inner_->frameCount();
     return n > skip_ ? n - std::size_t(skip_) : 0;
   }
-  SourceDamage damage() const override { return inner_->damage(); }
-  std::string healthReport() const override { return inner_->healthReport(); }
-  void setStopFlag(const std::atomic<bool>* stop) override { inner_->setStopFlag(stop); }
 
  private:
-  std::unique_ptr<FrameSource> inner_;
   uint64_t skip_;
   uint64_t skipped_ = 0;
 };

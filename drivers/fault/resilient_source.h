@@ -6,6 +6,7 @@
 //
 // next() blocks while reconnecting (sleeping through the injected clock), which is what a capture
 // thread wants; it returns kError only when max_reopen_attempts is exhausted.
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -24,9 +25,19 @@ struct ResilientSourceOptions {
   // No frame for this long (only kNoFrame results) counts as a failure and triggers a reopen.
   // 0 disables it. 3 s is ~100 frames at 30 Hz: far beyond any healthy USB hiccup.
   int64_t stall_timeout_ns = 3'000'000'000;
+  // > 0: backoff sleeps are cut into slices this long, and end early when wakeReconnect() was
+  // called (a USB arrival) or a stop was requested; and after deviceLeft() (the camera left the
+  // bus) reopen attempts wait, in such slices, for its arrival. 0: whole sleeps and no waiting
+  // for arrivals (what the tests' virtual clock schedule checks); sources opened from a spec use
+  // 20 ms.
+  int64_t wake_slice_ns = 0;
+  // After a departure, how long reopen attempts wait for the arrival before they go on with the
+  // backoff schedule anyway (an arrival event may be missed: udev restarted, a hub reset). The
+  // wait uses no attempt of the budget. 30 s: a replug by hand takes a few seconds.
+  int64_t absent_wait_ns = 30'000'000'000;
 };
 
-enum class SourceEventKind { kError, kStallTimeout, kReopenFailed, kReconnected, kGaveUp, kGap };
+enum class SourceEventKind { kError, kStallTimeout, kReopenFailed, kReconnected, kGaveUp, kGap, kWoken, kDeparted };
 
 struct SourceEvent {
   int64_t t_ns = 0;           // clock time of the event
@@ -45,7 +56,12 @@ struct ResilienceStats {
   uint64_t reopen_attempts = 0;
   uint64_t reopen_failures = 0;
   uint64_t reconnects = 0;
+  uint64_t hotplug_wakeups = 0;      // waits and backoffs ended by wakeReconnect() (USB arrival)
+  uint64_t usb_departures = 0;       // outages in which deviceLeft() was heard (once per outage)
+  uint64_t outages = 0;              // failures that started a reconnection
   int64_t time_disconnected_ns = 0;  // summed from failure to successful reopen
+  int64_t longest_outage_ns = 0;
+  int64_t arrival_to_frame_ns = -1;  // the last woken reconnection: arrival -> first frame (-1: none)
   // The first kMaxEvents events (bounded: a flapping sensor must not grow memory).
   static constexpr std::size_t kMaxEvents = 64;
   FixedVector<SourceEvent, kMaxEvents> events;
@@ -74,6 +90,14 @@ class ResilientSource : public FrameSource {
     stop_ = stop;
     inner_->setStopFlag(stop);
   }
+  // Thread-safe (the hot-plug listener's thread), with wake_slice_ns > 0. wakeReconnect: the
+  // camera arrived: the next reopen attempt of a reconnection in progress (or starting) happens
+  // now instead of after its backoff or its wait for the arrival. deviceLeft: the camera left:
+  // the next next() call reports the disconnect (event "usb camera left") and reconnects, and
+  // reopen attempts wait for the arrival (at most absent_wait_ns).
+  void wakeReconnect() override;
+  void deviceLeft() override;
+  bool supervision(SourceSupervision* out) const override;
 
   const ResilienceStats& stats() const { return stats_; }
   // One line per event ("t=1.250s error: ..."), for run reports.
@@ -82,6 +106,12 @@ class ResilientSource : public FrameSource {
  private:
   // Reopens with backoff; true when the source is back.
   bool recover();
+  // The backoff before the next reopen attempt; ends early on a wake-up or a stop request.
+  void sleepBackoff(int64_t backoff_ns);
+  // While the camera is off the bus: waits for its arrival (or a stop, or absent_wait_ns).
+  void waitForArrival(int64_t failed_at_ns);
+  // An arrival ended a wait: counted, and the first frame after the reconnection is timed.
+  void noteWoken();
   void record(SourceEventKind kind, uint64_t frames = 0);
 
   std::unique_ptr<FrameSource> inner_;
@@ -90,6 +120,12 @@ class ResilientSource : public FrameSource {
   ResilienceStats stats_;
   Status error_;
   const std::atomic<bool>* stop_ = nullptr;
+  std::atomic<bool> wake_{false};      // an arrival not yet acted on
+  std::atomic<bool> absent_{false};    // the camera is off the bus (between departure and arrival)
+  std::atomic<bool> departed_{false};  // a departure not yet reported by next() or recover()
+  std::atomic<int64_t> arrival_ns_{0};  // clock time of the last arrival
+  bool woken_ = false;                  // this reconnection was woken by an arrival
+  bool time_first_frame_ = false;       // the next frame ends arrival_to_frame_ns
   bool stopRequested() const { return stop_ != nullptr && stop_->load(std::memory_order_relaxed); }
   bool have_last_sequence_ = false;
   uint64_t last_sequence_ = 0;

@@ -1,14 +1,20 @@
 #include "drivers/open/sensor_source_specs.h"
 
+#include <cstdio>
 #include <cstdlib>
 
 #include "drivers/open/open_source.h"
+#include "drivers/common/forwarding_source.h"
 #include "drivers/dataset/camera_presets.h"
 #include "drivers/fault/resilient_source.h"
 #include "drivers/openni2/openni2_source.h"
 #include "drivers/recording/paced_source.h"
 #include "drivers/recording/recording_source.h"
 #include "drivers/v4l2/v4l2_source.h"
+#ifdef PLUMB_HAVE_LIBUSB
+#include "drivers/usb/libusb_backend.h"
+#include "drivers/usb/usb_arrival_waker.h"
+#endif
 
 namespace plumb {
 namespace {
@@ -18,8 +24,78 @@ bool endsWith(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-std::unique_ptr<FrameSource> supervised(std::unique_ptr<FrameSource> live) {
-  return std::make_unique<ResilientSource>(std::move(live), ResilientSourceOptions{});
+// The live camera's USB identity (spec suffix `@usb=VVVV:PPPP`): "" when not given.
+struct LiveOptions {
+  std::string usb_id;
+};
+
+#ifdef PLUMB_HAVE_LIBUSB
+// A supervised live source with a libusb hot-plug listener (UsbArrivalWaker): the camera arriving
+// wakes a reconnection in progress; with a configured VID:PID, its departure is reported as a
+// disconnect at once. Everything else is the supervised source's.
+class HotplugWakingSource : public ForwardingSource {
+ public:
+  HotplugWakingSource(std::unique_ptr<FrameSource> supervised, std::unique_ptr<UsbArrivalWaker> waker)
+      : ForwardingSource(std::move(supervised)), waker_(std::move(waker)) {}
+  ~HotplugWakingSource() override { waker_.reset(); }  // the listener goes before the source it wakes
+  std::string healthReport() const override {
+    const std::string report = inner_->healthReport();
+    const std::size_t end_of_summary = report.find('\n');
+    return report.substr(0, end_of_summary) + "; " + waker_->describe() +
+           (end_of_summary == std::string::npos ? "" : report.substr(end_of_summary));
+  }
+
+ private:
+  std::unique_ptr<UsbArrivalWaker> waker_;
+};
+#endif
+
+// Live sources are supervised (reopened with backoff); where libusb reports hot-plug events, the
+// camera arriving makes the next reopen attempt happen at once (and, with `@usb=`, its departure
+// is a disconnect). Without hot-plug events (no udev, no USB access): the backoff schedule alone.
+Status supervised(std::unique_ptr<FrameSource> live, const LiveOptions& live_options,
+                  std::unique_ptr<FrameSource>* out) {
+  ResilientSourceOptions options;
+  options.wake_slice_ns = 20'000'000;
+  auto resilient = std::make_unique<ResilientSource>(std::move(live), options);
+#ifdef PLUMB_HAVE_LIBUSB
+  UsbCameraId camera;
+  if (!live_options.usb_id.empty()) parseUsbCameraId(live_options.usb_id, &camera);  // checked on entry
+  std::unique_ptr<UsbBackend> backend;
+  std::unique_ptr<UsbArrivalWaker> waker;
+  ResilientSource* target = resilient.get();
+  UsbCameraEvents events{[target] { target->wakeReconnect(); }, [target] { target->deviceLeft(); }};
+  Status st = openLibusbBackend(&backend);
+  if (st.ok()) st = UsbArrivalWaker::create(std::move(backend), camera, std::move(events), &waker);
+  if (st.ok()) {
+    waker->startThread();
+    *out = std::make_unique<HotplugWakingSource>(std::move(resilient), std::move(waker));
+    return Status::Ok();
+  }
+  if (camera.configured())  // asked for, not available: say so rather than pretend
+    std::fprintf(stderr, "plumb: @usb=%s: no hot-plug events (%s); reconnecting on the backoff schedule\n",
+                 live_options.usb_id.c_str(), st.message().c_str());
+#else
+  (void)live_options;
+#endif
+  *out = std::move(resilient);
+  return Status::Ok();
+}
+
+// Splits `SPEC@usb=VVVV:PPPP` into SPEC and the id, checked before any device is opened.
+Status withoutUsbSuffix(const std::string& spec, std::string* device, LiveOptions* options) {
+  const std::size_t at = spec.rfind("@usb=");
+  *device = spec.substr(0, at);
+  if (at == std::string::npos) return Status::Ok();
+  options->usb_id = spec.substr(at + 5);
+#ifdef PLUMB_HAVE_LIBUSB
+  UsbCameraId id;
+  if (!parseUsbCameraId(options->usb_id, &id))
+    return Status::Error(spec + ": expected @usb=VID:PID in hex, e.g. @usb=8086:0b07");
+  return Status::Ok();
+#else
+  return Status::Error(spec + ": @usb= needs libusb, and this plumb was built without it (libusb-1.0-0-dev)");
+#endif
 }
 
 Status openRecording(const std::string& path, const std::string& camera_spec,
@@ -35,7 +111,7 @@ Status openRecording(const std::string& path, const std::string& camera_spec,
   return Status::Ok();
 }
 
-Status openOpenNI2(const std::string& uri, const std::string& camera_spec,
+Status openOpenNI2(const std::string& uri, const std::string& camera_spec, const LiveOptions& live,
                    std::unique_ptr<FrameSource>* out) {
   PinholeCamera fallback;
   if (!camera_spec.empty()) PLUMB_RETURN_IF_ERROR(cameraFromSpec(camera_spec, &fallback));
@@ -44,11 +120,15 @@ Status openOpenNI2(const std::string& uri, const std::string& camera_spec,
   std::unique_ptr<FrameSource> source;
   PLUMB_RETURN_IF_ERROR(
       openOpenNI2Source(options, camera_spec.empty() ? nullptr : &fallback, &source));
-  *out = source->isLive() ? supervised(std::move(source)) : std::move(source);
-  return Status::Ok();
+  if (!source->isLive()) {
+    if (!live.usb_id.empty()) return Status::Error(uri + ": @usb= is for live cameras, not recordings");
+    *out = std::move(source);
+    return Status::Ok();
+  }
+  return supervised(std::move(source), live, out);
 }
 
-Status openV4l2(const std::string& spec, const std::string& camera_spec,
+Status openV4l2(const std::string& spec, const std::string& camera_spec, const LiveOptions& live,
                 std::unique_ptr<FrameSource>* out) {
   std::string nodes = spec.substr(5);  // after "v4l2:"
   V4l2SourceOptions options;
@@ -70,8 +150,7 @@ Status openV4l2(const std::string& spec, const std::string& camera_spec,
   PLUMB_RETURN_IF_ERROR(cameraFromSpec(camera_spec, &camera));
   std::unique_ptr<V4l2Source> source;
   PLUMB_RETURN_IF_ERROR(V4l2Source::open(options, camera, systemV4l2Device(), &source));
-  *out = supervised(std::move(source));
-  return Status::Ok();
+  return supervised(std::move(source), live, out);
 }
 
 // paced:SPEC or paced@SPEED:SPEC around any other specification.
@@ -105,9 +184,12 @@ Status openSensorOrRecordingSource(const std::string& spec, const std::string& c
                                    std::unique_ptr<FrameSource>* out) {
   if (startsWith(spec, "paced:") || startsWith(spec, "paced@")) return openPaced(spec, camera_spec, out);
   if (endsWith(spec, ".plumbrec")) return openRecording(spec, camera_spec, out);
-  if (endsWith(spec, ".oni")) return openOpenNI2(spec, camera_spec, out);
-  if (startsWith(spec, "openni2:")) return openOpenNI2(spec.substr(8), camera_spec, out);
-  if (startsWith(spec, "v4l2:")) return openV4l2(spec, camera_spec, out);
+  LiveOptions live;
+  std::string device;
+  PLUMB_RETURN_IF_ERROR(withoutUsbSuffix(spec, &device, &live));
+  if (endsWith(device, ".oni")) return openOpenNI2(device, camera_spec, live, out);
+  if (startsWith(device, "openni2:")) return openOpenNI2(device.substr(8), camera_spec, live, out);
+  if (startsWith(device, "v4l2:")) return openV4l2(device, camera_spec, live, out);
   return Status::Error(spec + ": not a sensor or recording specification");
 }
 

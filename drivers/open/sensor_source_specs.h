@@ -7,7 +7,11 @@
 //                                      UVC colour node [+ Z16 depth node]; FORMAT yuyv (default),
 //                                      mjpeg or grey; needs --camera (V4L2 reports no intrinsics)
 //   paced:SPEC | paced@SPEED:SPEC      replay SPEC at its recorded rate (x SPEED), like a sensor
-// Live sources come wrapped in a ResilientSource (reopen with backoff after errors/stalls).
+//   LIVE@usb=VVVV:PPPP                 a live spec (v4l2:, openni2:) with its camera's USB VID:PID:
+//                                      libusb's departure of that device is a disconnect, its
+//                                      arrival reconnects (drivers/usb/usb_arrival_waker.h)
+// Live sources come wrapped in a ResilientSource (reopen with backoff after errors/stalls), with
+// a libusb hot-plug listener where libusb has hot-plug events.
 #include <memory>
 #include <string>
 

@@ -95,8 +95,10 @@ class Tracker {
   int matchLocalMap(const FrameFeatures& frame, const Eigen::Isometry3d& T_cam_world);
   void clearAssociations(const FrameFeatures& frame);
   // tracker_pose.cpp: optimise from T_cam_world, drop outlier associations, count inliers.
+  // final_pose = false (the first optimisation, on the last frame's matches): no covariance (one
+  // linearisation fewer). (A looser step tolerance there, 1e-4, moved head250's ATE by +14 %.)
   PoseResult optimizeAndPrune(const FrameFeatures& frame, const Eigen::Isometry3d& T_cam_world,
-                              TrackResult* result);
+                              TrackResult* result, bool final_pose = true);
   // The tracked pose's published covariances (TrackResult) from the final optimisation.
   // twist_per_s: the frame's velocity (timing model error, UncertaintyOptions).
   void publishCovariance(const PoseResult& pose, const Vector6d& twist_per_s, TrackResult* result) const;

@@ -145,6 +145,7 @@ std::string runSummaryJson(const RunSummary& r) {
                       r.map_loaded ? "true" : "false", r.map_read_ms, r.run->map_restore_ms, r.map_keyframes,
                       r.map_loop_edges, s.loaded_map_relocalized_frame, r.map_saved_keyframes, r.map_saved_bytes));
   }
+  if (!r.source_supervision_json.empty()) out += "  \"source_supervision\": " + r.source_supervision_json + ",\n";
   out += "  \"rss_checkpoints\": [";
   const std::vector<RssCheckpoint>& rss = r.statistics->rss();
   for (std::size_t i = 0; i < rss.size(); ++i) {

@@ -72,6 +72,9 @@ struct RunSummary {
   uint64_t map_keyframes = 0, map_loop_edges = 0;
   std::string map_saved_path;
   uint64_t map_saved_keyframes = 0, map_saved_bytes = 0;
+  // Supervised live sources: their outages as one JSON object, written as "source_supervision"
+  // when not empty (replays have none, so their statistics are unchanged).
+  std::string source_supervision_json;
 };
 std::string runSummaryJson(const RunSummary& summary);
 

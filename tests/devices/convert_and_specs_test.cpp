@@ -120,6 +120,16 @@ TEST(SensorSpecs, SensorSpecErrorsAreClear) {
             "v4l2:/dev/video0:rgb3: unknown colour format 'rgb3' (yuyv mjpeg grey)");
   const Status no_node = openFrameSource("v4l2:/dev/nonexistent-video,/dev/video1:mjpeg", "tum1", &source);
   EXPECT_EQ(no_node.message(), "/dev/nonexistent-video: open failed: No such file or directory");
+  // The camera's USB identity is checked before any device is opened; a good one reaches the node.
+#ifdef PLUMB_HAVE_LIBUSB
+  EXPECT_EQ(openFrameSource("v4l2:/dev/nonexistent-video@usb=8086", "tum1", &source).message(),
+            "v4l2:/dev/nonexistent-video@usb=8086: expected @usb=VID:PID in hex, e.g. @usb=8086:0b07");
+  EXPECT_EQ(openFrameSource("v4l2:/dev/nonexistent-video:yuyv@usb=8086:0b07", "tum1", &source).message(),
+            "/dev/nonexistent-video: open failed: No such file or directory");
+#else
+  EXPECT_NE(openFrameSource("v4l2:/dev/nonexistent-video@usb=8086:0b07", "tum1", &source).message().find("without"),
+            std::string::npos);
+#endif
 #ifdef PLUMB_HAVE_OPENNI2
   std::vector<OpenNI2DeviceInfo> devices;
   if (listOpenNI2Devices(&devices).ok() && devices.empty()) {

@@ -3,6 +3,9 @@
 // every reconnection.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <functional>
+
 #include "drivers/common/source_capture.h"
 #include "drivers/fault/fault_injecting_source.h"
 #include "drivers/fault/resilient_source.h"
@@ -191,6 +194,158 @@ TEST(FaultSupervision, WithoutAStopASilentLiveSourceIsAskedAgain) {
   FaultInjectingSource stalling(std::move(inner), {{1, FaultKind::kStall, 5}});
   SourceCapture capture(stalling, &stop);
   EXPECT_EQ(framesUntilTheCaptureEnds(capture), 4);
+}
+
+}  // namespace
+}  // namespace plumb
+
+// Hot-plug hints (UsbArrivalWaker calls them from its thread): an arrival cuts a backoff short; a
+// departure is a disconnect at once, and reopening waits for the arrival.
+namespace plumb {
+namespace {
+
+// A virtual clock that calls `hook(n)` after its n-th sleep: the camera's USB events, on time.
+class HookedClock : public VirtualClock {
+ public:
+  void sleepForNs(int64_t ns) override {
+    VirtualClock::sleepForNs(ns);
+    if (hook) hook(sleeps_ns.size());
+  }
+  std::function<void(std::size_t)> hook;
+};
+
+struct HotplugRig {
+  HookedClock clock;
+  FaultInjectingSource* faulty = nullptr;
+  std::unique_ptr<ResilientSource> supervised;
+};
+
+std::unique_ptr<HotplugRig> makeHotplugRig(std::vector<FaultEvent> plan, ResilientSourceOptions options) {
+  auto rig = std::make_unique<HotplugRig>();
+  auto inner = std::make_unique<test::VectorSource>(test::makeNoiseFrames(9, 8, 6, 10), test::smallCamera(8, 6));
+  auto faulty = std::make_unique<FaultInjectingSource>(std::move(inner), std::move(plan));
+  rig->faulty = faulty.get();
+  options.wake_slice_ns = 20'000'000;
+  rig->supervised = std::make_unique<ResilientSource>(std::move(faulty), options, rig->clock);
+  return rig;
+}
+
+std::size_t countOf(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+TEST(FaultSupervision, AHotplugWakeUpEndsTheBackoffEarly) {
+  ResilientSourceOptions options;
+  options.initial_backoff_ns = 500'000'000;
+  auto rig = makeHotplugRig({{3, FaultKind::kDisconnect, 2, /*failed reopens*/ 1}}, options);
+  ResilientSource& supervised = *rig->supervised;
+  rig->clock.hook = [&](std::size_t sleeps) {
+    if (sleeps == 1) supervised.wakeReconnect();  // the camera arrives 20 ms into the 500 ms backoff
+  };
+  const std::vector<uint64_t> delivered = drain(supervised);
+  EXPECT_EQ(delivered.size(), 8u);
+  EXPECT_EQ(rig->clock.sleeps_ns, (std::vector<int64_t>{20'000'000})) << "woken after the first 20 ms slice";
+  EXPECT_EQ(supervised.stats().hotplug_wakeups, 1u);
+  EXPECT_EQ(supervised.stats().reconnects, 1u);
+  EXPECT_EQ(supervised.stats().usb_departures, 0u);
+  EXPECT_NE(supervised.describeEvents().find("woken by a hot-plug arrival"), std::string::npos);
+}
+
+TEST(FaultSupervision, ADepartureIsADisconnectAndTheReopenWaitsForTheArrival) {
+  auto rig = makeHotplugRig({}, ResilientSourceOptions{});
+  ResilientSource& supervised = *rig->supervised;
+  rig->clock.hook = [&](std::size_t sleeps) {
+    if (sleeps == 100) supervised.wakeReconnect();  // replugged 2 s (100 slices) later
+  };
+  RgbdImage out;
+  for (int i = 0; i < 4; ++i) ASSERT_EQ(supervised.next(out), SourceResult::kFrame);
+  supervised.deviceLeft();  // libusb: the camera left; the source itself has not failed
+  std::vector<uint64_t> delivered = drain(supervised);
+  EXPECT_EQ(delivered.size(), 6u) << "frames 4..9 after the reconnection";
+  EXPECT_EQ(delivered.front(), 4u);
+  const ResilienceStats& stats = supervised.stats();
+  EXPECT_EQ(stats.usb_departures, 1u);
+  EXPECT_EQ(stats.outages, 1u);
+  EXPECT_EQ(stats.errors, 0u);
+  EXPECT_EQ(stats.reopen_attempts, 1u) << "no reopen while the camera was off the bus";
+  EXPECT_EQ(stats.reconnects, 1u);
+  EXPECT_EQ(stats.hotplug_wakeups, 1u);
+  EXPECT_EQ(rig->clock.sleeps_ns.size(), 100u);
+  EXPECT_EQ(stats.time_disconnected_ns, 2'000'000'000);
+  EXPECT_EQ(stats.longest_outage_ns, 2'000'000'000);
+  EXPECT_EQ(stats.arrival_to_frame_ns, 0) << "the first frame came at the arrival's (virtual) time";
+  const std::string events = supervised.describeEvents();
+  EXPECT_NE(events.find("after frame 3: usb camera left"), std::string::npos) << events;
+  EXPECT_NE(events.find("t=2.000s after frame 3: woken by a hot-plug arrival"), std::string::npos) << events;
+  SourceSupervision s;
+  ASSERT_TRUE(supervised.supervision(&s));
+  EXPECT_EQ(s.usb_departures, 1u);
+  EXPECT_EQ(s.usb_arrivals, 1u);
+  EXPECT_EQ(s.outages, 1u);
+  EXPECT_EQ(s.longest_outage_ns, 2'000'000'000);
+  EXPECT_EQ(s.arrival_to_frame_ns, 0);
+  EXPECT_NE(supervised.healthReport().find("longest outage 2.000 s, 0 failed reopens, usb departures 1, hot-plug wake-ups 1"),
+            std::string::npos)
+      << supervised.healthReport();
+}
+
+TEST(FaultSupervision, ADepartureHeardDuringAnErrorOutageIsCountedOnceAndGatesTheReopens) {
+  // A real camera: the driver fails first (ENODEV), libusb's departure comes during the backoff.
+  auto rig = makeHotplugRig({{3, FaultKind::kDisconnect, 0, /*failed reopens*/ 1}}, ResilientSourceOptions{});
+  ResilientSource& supervised = *rig->supervised;
+  rig->clock.hook = [&](std::size_t sleeps) {
+    if (sleeps == 1) supervised.deviceLeft();
+    if (sleeps == 40) supervised.wakeReconnect();
+  };
+  const std::vector<uint64_t> delivered = drain(supervised);
+  EXPECT_EQ(delivered.size(), 10u);
+  const ResilienceStats& stats = supervised.stats();
+  EXPECT_EQ(stats.errors, 1u);
+  EXPECT_EQ(stats.outages, 1u) << "the departure belongs to the outage the error started";
+  EXPECT_EQ(stats.usb_departures, 1u);
+  EXPECT_EQ(stats.reopen_attempts, 2u) << "one failed before the departure was heard, one after the arrival";
+  EXPECT_EQ(stats.reconnects, 1u);
+  EXPECT_EQ(stats.hotplug_wakeups, 1u);
+  // 50 ms backoff (20 + 20 + 10), then the wait for the arrival in 20 ms slices up to sleep 40.
+  EXPECT_EQ(rig->clock.sleeps_ns.size(), 40u);
+  EXPECT_EQ(countOf(supervised.describeEvents(), "usb camera left"), 0u) << "no second disconnect after the reconnection";
+}
+
+TEST(FaultSupervision, WithoutTheArrivalReopeningResumesAfterTheAbsentWait) {
+  ResilientSourceOptions options;
+  options.absent_wait_ns = 1'000'000'000;
+  auto rig = makeHotplugRig({}, options);
+  ResilientSource& supervised = *rig->supervised;
+  RgbdImage out;
+  ASSERT_EQ(supervised.next(out), SourceResult::kFrame);
+  supervised.deviceLeft();  // and no arrival is ever heard (udev restarted, say)
+  const std::vector<uint64_t> delivered = drain(supervised);
+  EXPECT_EQ(delivered.size(), 9u);
+  const ResilienceStats& stats = supervised.stats();
+  EXPECT_EQ(stats.reconnects, 1u);
+  EXPECT_EQ(stats.hotplug_wakeups, 0u);
+  EXPECT_EQ(stats.time_disconnected_ns, 1'000'000'000);
+  EXPECT_EQ(stats.arrival_to_frame_ns, -1) << "no arrival woke this reconnection";
+}
+
+TEST(FaultSupervision, AStopEndsTheWaitForTheArrival) {
+  auto rig = makeHotplugRig({}, ResilientSourceOptions{});
+  ResilientSource& supervised = *rig->supervised;
+  std::atomic<bool> stop{false};
+  supervised.setStopFlag(&stop);
+  rig->clock.hook = [&](std::size_t sleeps) {
+    if (sleeps == 5) stop.store(true);
+  };
+  RgbdImage out;
+  ASSERT_EQ(supervised.next(out), SourceResult::kFrame);
+  supervised.deviceLeft();
+  EXPECT_EQ(supervised.next(out), SourceResult::kNoFrame);
+  EXPECT_EQ(rig->clock.sleeps_ns.size(), 5u);
+  EXPECT_EQ(supervised.stats().reopen_attempts, 0u);
+  EXPECT_EQ(supervised.stats().usb_departures, 1u);
+  EXPECT_EQ(supervised.stats().time_disconnected_ns, 100'000'000);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #ifdef PLUMB_HAVE_LIBUSB
 #include "drivers/usb/camera_monitor.h"
 #include "drivers/usb/libusb_backend.h"
+#include "drivers/usb/usb_arrival_waker.h"
 
 namespace plumb {
 namespace {
@@ -65,6 +66,64 @@ UsbDeviceId device(uint16_t vid, uint16_t pid, const std::string& port) {
   id.bus = static_cast<uint8_t>(port[0] - '0');
   id.port_path = port;
   return id;
+}
+
+TEST(UsbArrivalWaker, WithoutAConfiguredIdEveryTableCameraArrivalWakesAndNoDepartureCounts) {
+  auto backend = std::make_unique<FakeUsbBackend>();
+  FakeUsbBackend* fake = backend.get();
+  int arrived = 0, left = 0;
+  std::unique_ptr<UsbArrivalWaker> waker;
+  ASSERT_TRUE(UsbArrivalWaker::create(std::move(backend), UsbCameraId{}, {[&] { ++arrived; }, [&] { ++left; }}, &waker)
+                  .ok());
+  ASSERT_NE(fake->handler, nullptr);
+  fake->handler->onArrived(device(0x046d, 0xc52b, "1-3"));  // a mouse
+  EXPECT_EQ(arrived, 0);
+  fake->handler->onArrived(device(0x8086, 0x0b07, "2-1"));  // a D435
+  EXPECT_EQ(arrived, 1);
+  fake->handler->onLeft(device(0x8086, 0x0b07, "2-1"));  // whose camera? unknown: not a disconnect
+  EXPECT_EQ(left, 0);
+  fake->handler->onArrived(device(0x2bc5, 0x0401, "2-2"));  // an Orbbec
+  EXPECT_EQ(arrived, 2);
+  EXPECT_EQ(waker->arrivals(), 2u);
+  EXPECT_EQ(waker->departures(), 0u);
+  EXPECT_EQ(waker->describe(), "usb: RGB-D cameras arrived 2");
+  EXPECT_TRUE(waker->pollOnce(0).ok());
+}
+
+TEST(UsbArrivalWaker, AConfiguredIdWakesOnItsArrivalAndReportsItsDeparture) {
+  auto backend = std::make_unique<FakeUsbBackend>();
+  FakeUsbBackend* fake = backend.get();
+  int arrived = 0, left = 0;
+  UsbCameraId gadget;
+  ASSERT_TRUE(parseUsbCameraId("1d6b:104", &gadget));  // not in the table: configured ids need not be
+  std::unique_ptr<UsbArrivalWaker> waker;
+  ASSERT_TRUE(UsbArrivalWaker::create(std::move(backend), gadget, {[&] { ++arrived; }, [&] { ++left; }}, &waker).ok());
+  fake->handler->onArrived(device(0x8086, 0x0b07, "2-1"));  // another camera: not ours
+  fake->handler->onLeft(device(0x8086, 0x0b07, "2-1"));
+  EXPECT_EQ(arrived + left, 0);
+  fake->handler->onLeft(device(0x1d6b, 0x0104, "1-1"));
+  EXPECT_EQ(left, 1);
+  EXPECT_EQ(arrived, 0);
+  fake->handler->onArrived(device(0x1d6b, 0x0104, "1-1"));
+  EXPECT_EQ(arrived, 1);
+  EXPECT_EQ(waker->describe(), "usb 1d6b:0104 arrived 1, left 1");
+}
+
+TEST(UsbArrivalWaker, NeedsHotplugAndAWellFormedId) {
+  auto without_hotplug = std::make_unique<FakeUsbBackend>();
+  without_hotplug->hotplug = false;
+  std::unique_ptr<UsbArrivalWaker> none;
+  EXPECT_FALSE(UsbArrivalWaker::create(std::move(without_hotplug), UsbCameraId{}, {}, &none).ok());
+  EXPECT_EQ(none, nullptr);
+  UsbCameraId id;
+  EXPECT_TRUE(parseUsbCameraId("8086:0B07", &id));
+  EXPECT_EQ(id.vendor_id, 0x8086);
+  EXPECT_EQ(id.product_id, 0x0b07);
+  for (const char* bad : {"", "8086", "8086:", ":0b07", "8086:0b07x", "18086:0b07", "0:0", "80 6:0b07", "-1:2", "g086:0b07"}) {
+    UsbCameraId untouched{1, 2};
+    EXPECT_FALSE(parseUsbCameraId(bad, &untouched)) << bad;
+    EXPECT_EQ(untouched.vendor_id, 1) << bad;
+  }
 }
 
 TEST(CameraMonitor, ScanKeepsOnlyCamerasAndSaysWhichSourceOpensThem) {
