@@ -182,11 +182,16 @@ bool LoopCloser::addKeyframe(const LoopKeyframe& record) {
   // Query before inserting: a keyframe never finds itself.
   const PlaceDescriptors descriptors{r.point_descriptors.data(), r.point_descriptors.size(),
                                      r.line_descriptors.data(), r.line_descriptors.size()};
-  if (r.id > uint32_t(options_.min_age_keyframes)) {
+  // Early consistency: the query also returns the keyframes up to `lookahead` ids younger than the
+  // age bound, for the consistency count only (detect() verifies none of them), and keyframes
+  // start querying that much earlier, so the first keyframes old enough to be candidates can be
+  // consistent already.
+  const int lookahead = options_.early_consistency ? std::max(0, options_.min_consistent - 1) : 0;
+  if (int64_t(r.id) > int64_t(options_.min_age_keyframes) - lookahead) {
     ++stats_.queries;
     PlaceQueryOptions q;
-    q.max_results = std::size_t(std::min<int>(options_.candidates, int(kMaxPlaceCandidates)));
-    q.max_candidate_id = uint64_t(r.id) - uint64_t(options_.min_age_keyframes);
+    q.max_results = std::size_t(std::min<int>(options_.candidates + lookahead, int(kMaxPlaceCandidates)));
+    q.max_candidate_id = uint64_t(int64_t(r.id) - int64_t(options_.min_age_keyframes) + lookahead);
     q.min_score = options_.min_candidate_score;
     database_.query(descriptors, q, &candidates_);
     const std::size_t before = stats_.loops_accepted;
@@ -234,6 +239,7 @@ void LoopCloser::detect(const LoopKeyframe& query_record, int query_position) {
   int verified = 0;
   for (const Group& g : groups_) {  // candidates_ order: best score first
     if (g.count < options_.min_consistent || verified >= options_.max_verifications) continue;
+    if (int64_t(g.id) > int64_t(query.id) - int64_t(options_.min_age_keyframes)) continue;  // consistency only
     ++stats_.consistent_candidates;
     const int candidate_position = findPosition(g.id);
     if (candidate_position < 0) continue;  // culled meanwhile

@@ -61,6 +61,12 @@ struct LoopCloserOptions {
   double min_candidate_score = 0.02;
   int consistency_neighbourhood = 4;  // candidate ids this close name the same place
   int min_consistent = 3;             // consecutive queries agreeing, this one included
+  // The consistency count can be met at the age bound: each query also lists the min_consistent - 1
+  // keyframes just younger than `min_age_keyframes` (never verified: counted only), and queries
+  // start that many keyframes earlier. Without it the first two keyframes old enough to have a
+  // candidate can never be consistent, and a room lap of ~34 keyframes (office_loop) lost exactly
+  // its closest revisit (docs/LOOP.md "Recall").
+  bool early_consistency = true;
   int max_verifications = 3;          // consistent candidates verified per query, best score first
   int cooldown_keyframes = 3;         // after an accepted loop, keyframes not searched
   LoopVerifierOptions verifier;

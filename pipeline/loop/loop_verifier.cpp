@@ -34,13 +34,16 @@ const char* toString(LoopRejection r) {
   return "?";
 }
 
+// A query point matches one candidate point, or two when the ratio test cannot tell them apart.
+constexpr std::size_t kMaxPointHypotheses = 2 * kMaxLoopPoints;
+
 struct LoopVerifier::Scratch {
-  std::array<uint16_t, kMaxLoopPoints> query_index{};  // per match
-  std::array<Eigen::Vector3d, kMaxLoopPoints> from{};  // query camera
-  std::array<Eigen::Vector3d, kMaxLoopPoints> to{};    // candidate camera
-  std::array<int8_t, kMaxLoopPoints> candidate_octave{};
-  std::array<bool, kMaxLoopPoints> ransac_scratch{};
-  std::array<bool, kMaxLoopPoints> inlier{};
+  std::array<uint16_t, kMaxPointHypotheses> query_index{};  // per hypothesis
+  std::array<Eigen::Vector3d, kMaxPointHypotheses> from{};  // query camera
+  std::array<Eigen::Vector3d, kMaxPointHypotheses> to{};    // candidate camera
+  std::array<int8_t, kMaxPointHypotheses> candidate_octave{};
+  std::array<bool, kMaxPointHypotheses> ransac_scratch{};
+  std::array<bool, kMaxPointHypotheses> inlier{};
   std::array<PosePointObservation, kMaxLoopPoints> pose_points{};
   std::array<bool, kMaxLoopPoints> pose_point_inlier{};
   std::array<PoseLineObservation, kMaxLoopLines * kMaxLineSamples> pose_lines{};
@@ -119,30 +122,48 @@ Matrix6d LoopVerifier::calibratedCovariance(const PoseResult& pose, const PoseOp
 LoopMeasurement LoopVerifier::verify(const LoopKeyframe& query, const LoopCandidate& candidate) {
   LoopMeasurement m;
   Scratch& s = *s_;
-  // 1. Points.
+  // 1. Points. A query point whose two nearest candidate descriptors are too alike for the ratio
+  // test (a copy of the same furniture, a repeated texture) enters with BOTH as hypotheses when
+  // both are within the Hamming bound: the rigid RANSAC below tells them apart by geometry, where
+  // the ratio test could only drop the point. The counts below are of query points.
   int n = 0;
-  for (std::size_t k = 0; k < query.points.size(); ++k) {
-    const int j = bestRatioMatch(query.point_descriptors[k], candidate.point_descriptors.data(),
-                            candidate.num_points, options_.hamming_threshold, options_.ratio);
-    if (j < 0) continue;
+  auto hypothesis = [&](std::size_t k, int j) {
     s.query_index[std::size_t(n)] = uint16_t(k);
     s.from[std::size_t(n)] = query.points[k].P_cam.cast<double>();
     s.to[std::size_t(n)] = candidate.P_cam[std::size_t(j)].cast<double>();
     s.candidate_octave[std::size_t(n)] = candidate.point_octave[std::size_t(j)];
     ++n;
+  };
+  for (std::size_t k = 0; k < query.points.size(); ++k) {
+    const NearestTwo nearest =
+        nearestTwo(query.point_descriptors[k], candidate.point_descriptors.data(), candidate.num_points);
+    if (nearest.best_index < 0 || nearest.best > options_.hamming_threshold) continue;
+    const bool clear = passesRatio(nearest, options_.ratio);
+    const bool ambiguous = !clear && options_.ambiguous_pairs && nearest.second <= options_.hamming_threshold;
+    if (!clear && !ambiguous) continue;
+    hypothesis(k, nearest.best_index);
+    if (ambiguous) hypothesis(k, nearest.second_index);
+    ++m.matches;
   }
-  m.matches = n;
-  if (n < options_.min_matches) return m;
+  if (m.matches < options_.min_matches) return m;
 
   // 2. Rigid RANSAC: T_candidate_query maps query-camera points onto candidate-camera points.
   Eigen::Isometry3d T_cq = Eigen::Isometry3d::Identity();
-  m.ransac_inliers = rigidRansac(s.from.data(), s.to.data(), n, options_.ransac, s.ransac_scratch.data(),
-                                 s.inlier.data(), &T_cq);
+  (void)rigidRansac(s.from.data(), s.to.data(), n, options_.ransac, s.ransac_scratch.data(), s.inlier.data(),
+                    &T_cq);
+  // One inlier per query point (its two hypotheses are adjacent; both fit only when the two
+  // candidate points lie within the inlier threshold of each other).
+  m.ransac_inliers = 0;
+  for (int i = 0; i < n; ++i) {
+    const std::size_t u = std::size_t(i);
+    if (s.inlier[u] && i > 0 && s.inlier[u - 1] && s.query_index[u - 1] == s.query_index[u]) s.inlier[u] = false;
+    m.ransac_inliers += s.inlier[u] ? 1 : 0;
+  }
   if (m.ransac_inliers < options_.min_inliers) {
     m.rejection = LoopRejection::kFewInliers;
     return m;
   }
-  if (double(m.ransac_inliers) < options_.min_inlier_ratio * double(n)) {
+  if (double(m.ransac_inliers) < options_.min_inlier_ratio * double(m.matches)) {
     m.rejection = LoopRejection::kLowInlierRatio;
     return m;
   }

@@ -77,6 +77,34 @@ TEST(LoopCloser, ClosesADriftedLoopAndCorrectsTheGraph) {
   EXPECT_GE(closer.stats().optimisations, 1u);
 }
 
+// A lap of exactly min_age_keyframes keyframes: keyframe id 34 (k = 33) stands where id 1 stood,
+// the first keyframe that may have a candidate at all. The two queries before it list the place
+// for the consistency count only (early_consistency), so the loop closes right there; without it
+// the count of 3 consecutive queries cannot be met before id 36, two keyframes past the revisit.
+TEST(LoopCloser, ARevisitAtTheAgeBoundIsConsistentAtOnce) {
+  const Scene scene = cylinderScene(22, 6000, 3.5);
+  const int per_lap = loop::LoopCloserOptions{}.min_age_keyframes;
+  auto pose_at = [&](int k) { return outwardPose(2 * M_PI * k / per_lap, 1.0); };
+  auto first_loop = [&](bool early) {
+    loop::LoopCloserOptions options;
+    options.early_consistency = early;
+    loop::LoopCloser closer = makeCloser(options);
+    Eigen::Isometry3d T_odometry = pose_at(0);
+    for (int k = 0; k < per_lap + 8; ++k) {
+      Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+      if (k > 0) {
+        step = driftedStep(pose_at(k - 1).inverse() * pose_at(k));
+        T_odometry = T_odometry * step;
+      }
+      const auto record = recordOf(scene, uint32_t(k + 1), pose_at(k), T_odometry, k > 0 ? uint32_t(k) : 0, step);
+      if (closer.addKeyframe(*record)) return k;
+    }
+    return -1;
+  };
+  EXPECT_EQ(first_loop(true), per_lap);
+  EXPECT_GE(first_loop(false), per_lap + 2);
+}
+
 // A corridor of identical 3 m modules along x (points on the wall y = 2 m, the same descriptors
 // in every module), walked one way with exact odometry: every module looks like the one before.
 TEST(LoopCloser, RejectsRepeatedTextureWithoutARealLoop) {

@@ -188,5 +188,49 @@ TEST(LoopVerifier, CovarianceDescribesTheErrorsWhenBothEndsAreNoisy) {
   EXPECT_GT(without, 1.5);
 }
 
+// Repeated furniture: most points of the candidate view have an identical copy 1.75 m to the side
+// (same descriptor), listed first so that it is the nearest descriptor on the tie. The ratio test
+// cannot tell a point from its copy and drops it; with both as RANSAC hypotheses the geometry of
+// the points that do differ (and of the originals) decides, and the pose is the true one.
+TEST(LoopVerifier, RepeatedFurnitureIsMatchedByGeometryWhereTheRatioTestDropsIt) {
+  const Eigen::Isometry3d Ta = Eigen::Isometry3d::Identity();
+  const Scene scene = makeScene(14, 220, 0, Ta);
+  const Eigen::Isometry3d Tb = pose(3, Eigen::Vector3d(0.1, 1, -0.2), Eigen::Vector3d(0.15, 0.05, -0.1));
+  const auto a = recordOf(scene, 1, Ta, Ta, 0, Ta);
+  const auto b = recordOf(scene, 50, Tb, Tb, 0, Ta);
+  const auto original = candidateOf(*a);
+  ASSERT_GT(original->num_points, 150);
+  const int unique = 30;  // points with no copy (fewer than min_matches)
+  const int furniture = original->num_points - unique;
+  auto repeated = std::make_unique<loop::LoopCandidate>(*original);
+  int k = 0;
+  for (int i = 0; i < furniture; ++i, ++k) {
+    repeated->point_descriptors[std::size_t(k)] = original->point_descriptors[std::size_t(i)];
+    repeated->P_cam[std::size_t(k)] = original->P_cam[std::size_t(i)] + Eigen::Vector3f(1.75f, 0, 0);
+  }
+  for (int i = 0; i < original->num_points; ++i, ++k) {
+    repeated->point_descriptors[std::size_t(k)] = original->point_descriptors[std::size_t(i)];
+    repeated->P_cam[std::size_t(k)] = original->P_cam[std::size_t(i)];
+  }
+  repeated->num_points = uint16_t(k);
+
+  loop::LoopVerifierOptions ratio_only;
+  ratio_only.ambiguous_pairs = false;
+  loop::LoopVerifier dropping(intrinsicsOf(syntheticCamera()), NoiseModelOptions{}, ratio_only);
+  const loop::LoopMeasurement dropped = dropping.verify(*b, *repeated);
+  EXPECT_EQ(dropped.rejection, loop::LoopRejection::kFewMatches);
+  EXPECT_LE(dropped.matches, unique);
+
+  auto verifier = makeVerifier();
+  const loop::LoopMeasurement m = verifier.verify(*b, *repeated);
+  ASSERT_TRUE(m.accepted()) << loop::toString(m.rejection) << " matches " << m.matches;
+  const Eigen::Isometry3d truth = Ta.inverse() * Tb;
+  EXPECT_LT(translationError(m.T_candidate_query, truth), 1e-3);
+  EXPECT_LT(rotationErrorDeg(m.T_candidate_query, truth), 0.05);
+  EXPECT_GT(m.matches, 150);  // query points, each counted once
+  EXPECT_LE(m.ransac_inliers, m.matches);
+  EXPECT_GT(m.ransac_inliers, 150);  // the originals, not their copies
+}
+
 }  // namespace
 }  // namespace plumb::test
