@@ -97,6 +97,8 @@ class Tracker {
   // tracker_pose.cpp: optimise from T_cam_world, drop outlier associations, count inliers.
   PoseResult optimizeAndPrune(const FrameFeatures& frame, const Eigen::Isometry3d& T_cam_world,
                               TrackResult* result);
+  // 1 / (keyframes that measured the landmark at local_index of the snapshot; 1 when unknown).
+  double mapShare(int local_index, bool point) const;
   // The tracked pose's published covariances (TrackResult) from the final optimisation.
   // twist_per_s: the frame's velocity (timing model error, UncertaintyOptions).
   void publishCovariance(const PoseResult& pose, const Vector6d& twist_per_s, TrackResult* result) const;

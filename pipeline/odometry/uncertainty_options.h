@@ -27,6 +27,13 @@ struct UncertaintyOptions {
   // Scale on the tracked pose's covariance relative to the map (pose-only optimisation with the
   // landmarks held fixed) and its floor sigmas.
   double tracked_scale = 1.5;
+  // Add the landmarks' own position errors to the tracked pose's WORLD covariance (not to the
+  // map-relative one the velocity uses: consecutive frames share them). Pose-only optimisation
+  // holds the landmarks exact; a landmark from n keyframe measurements is taken to carry 1/n of
+  // one measurement's covariance (solver/pose_optimizer.h, Tracker::mapShare), so right after a
+  // keyframe, whose landmarks were measured once, the frame's error relative to it is about twice
+  // what pose-only says. Scaled like the tracked covariance (variance factor, tracked_scale).
+  bool tracked_map_error = true;
   double tracked_floor_translation_m = 0.0;
   double tracked_floor_rotation_rad = 0.0;
   // Timing model error: the pose published for a frame is the camera's at the frame's timestamp,
