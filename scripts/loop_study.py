@@ -117,6 +117,9 @@ def evaluate(args, seq):
     if grading:
         row.update({k: grading.get(k, 0) for k in ("accepted", "graded", "correct", "within_5cm_2deg", "revisits",
                                                    "revisits_recalled")})
+        # NEES of each graded loop constraint: error_sigmas^2 = e^T S^-1 e (6 dof).
+        row["nees"] = [l["error_sigmas"] ** 2 for l in grading.get("loops", [])
+                       if l.get("ground_truth") and l.get("error_sigmas") is not None]
     with open(base + ".stats.json") as f:
         stats = json.load(f)
     lc = stats.get("loop_closing", {})
@@ -156,12 +159,13 @@ def main():
     rows = [evaluate(args, s) for s in seqs]
 
     print("| sequence | no loops ATE [m] | `--out` ATE [m] | `--out` / no loops | `--out-optimized` ATE [m] | "
-          "opt / no loops | loops accepted / correct (within 5 cm, 2 deg) | revisits recalled | verdict |")
-    print("|---|---|---|---|---|---|---|---|---|")
+          "opt / no loops | loops accepted / correct (within 5 cm, 2 deg) | loop NEES/dof (max) | revisits recalled | verdict |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     totals = {"rows": 0, "fail_rt": 0, "fail_opt": 0, "accepted": 0, "correct": 0, "revisits": 0, "recalled": 0}
+    all_nees = []
     for r in rows:
         if "error" in r or r.get("noloops") is None or r.get("rt") is None or r.get("opt") is None:
-            print(f"| {r['name']} | {r.get('error', 'evaluation failed')} | | | | | | | |")
+            print(f"| {r['name']} | {r.get('error', 'evaluation failed')} | | | | | | | | |")
             continue
         totals["rows"] += 1
         rt_ratio, opt_ratio = r["rt"] / r["noloops"], r["opt"] / r["noloops"]
@@ -179,13 +183,16 @@ def main():
                            (f" ({far} beyond 5 cm / 2 deg)" if far else " (within 5 cm / 2 deg, beyond 3 sigma)"))
         totals["accepted"] += r.get("graded", 0)
         totals["correct"] += correct
+        nees = r.get("nees", [])
+        all_nees += nees
+        nees_cell = f"{sum(nees) / len(nees) / 6:.2f} ({max(nees) / 6:.2f})" if nees else "-"
         recall = "-"
         if r["looped"] and r.get("revisits"):
             totals["revisits"] += r["revisits"]
             totals["recalled"] += r["revisits_recalled"]
             recall = f"{r['revisits_recalled']}/{r['revisits']}"
         print(f"| {r['name']} | {fmt(r['noloops'])} | {fmt(r['rt'])} | {rt_ratio:.3f} | {fmt(r['opt'])} | "
-              f"{opt_ratio:.3f} | {accepted} / {correct} ({r.get('within_5cm_2deg', 0)}) | {recall} | {'ok' if not verdict else ', '.join(verdict)} |")
+              f"{opt_ratio:.3f} | {accepted} / {correct} ({r.get('within_5cm_2deg', 0)}) | {nees_cell} | {recall} | {'ok' if not verdict else ', '.join(verdict)} |")
     precision = 100.0 * totals["correct"] / totals["accepted"] if totals["accepted"] else 100.0
     recall = 100.0 * totals["recalled"] / totals["revisits"] if totals["revisits"] else float("nan")
     print()
@@ -193,6 +200,10 @@ def main():
           f"`--out` worse by > 5 % on {totals['fail_rt']}; loop precision {precision:.1f} % "
           f"({totals['correct']} of {totals['accepted']}); recall {recall:.1f} % of the revisits of the looped "
           f"sequences ({totals['recalled']} of {totals['revisits']}).")
+    if all_nees:
+        inside = sum(1 for x in all_nees if x <= 12.59)  # 6-dof chi-square, 95 %
+        print(f"Loop constraints: mean NEES/dof {sum(all_nees) / len(all_nees) / 6:.2f} over {len(all_nees)} "
+              f"accepted loops, {100.0 * inside / len(all_nees):.0f} % inside the 95 % ellipsoid.")
 
 
 if __name__ == "__main__":

@@ -203,7 +203,11 @@ class LocalBundleAdjuster {
     Eigen::Vector3d z = Eigen::Vector3d::Zero();  // [u,v,u_r] | [u,v,-] | line [a,b,c]
     Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
     Matrix63d W = Matrix63d::Zero();  // J_pose^T w Omega J_point
-    Matrix63d V = Matrix63d::Zero();  // W H_point_inv
+    // W H_point_inv, except for line samples in a landmark seen only by line samples (all of
+    // them, as the local mapper builds its problems): their W is rank one, W = u r^T with
+    // u = [w J^T; P_cam x w J^T] (6) and r = R^T J^T (3), and the elimination only needs u, r and
+    // H_point_inv r, kept here as columns 0, 1 (top) and 2 (top); see solveDamped.
+    Matrix63d V = Matrix63d::Zero();
     double chi2 = 0.0;
     int keyframe = 0;
     int landmark = 0;

@@ -145,16 +145,33 @@ double LocalBundleAdjuster::linearize(const LocalBaOptions& options) {
           break;
         }
         case ObservationKind::kLineSample:
-        default: {  // (the enum has no other value; keeps M and q visibly assigned)
+        default: {  // (the enum has no other value)
+          // Rank one: with j = J_cam^T and c = w Omega, M = c j j^T, so every block is an outer
+          // product: R^T M R = c r r^T (r = R^T j), W = A^T M R = u r^T (u = c A^T j =
+          // c [j; P_cam x j]) and A^T M A = u (A^T j)^T, about half the work of the 3x3 forms.
           double e = 0.0;
           Eigen::RowVector3d J_cam;
           lineResidualAt(camera_, P_cam, obs.z, &e, &J_cam);
           obs.chi2 = e * e * obs.information(0, 0);
           k = evaluateKernel(kernel, obs.chi2);
-          const Eigen::Vector3d wj = (k.rho1 * obs.information(0, 0)) * J_cam.transpose();
-          M.noalias() = wj * J_cam;  // rank one
-          q = e * wj;
-          break;
+          cost += 0.5 * k.rho;
+          obs.valid = true;
+          obs.outlier = false;
+          const double c = k.rho1 * obs.information(0, 0);
+          const Eigen::Vector3d j = J_cam.transpose();
+          const Eigen::Vector3d r = kf.T_cam_world.linear().transpose() * j;
+          const Eigen::Vector3d cr = c * r;
+          lm.H_point.noalias() += cr * r.transpose();
+          lm.g_point += e * cr;
+          if (kf.variable < 0) continue;
+          Vector6d A_t_j;
+          A_t_j << j, P_cam.cross(j);
+          const Vector6d u = c * A_t_j;
+          kf.normal.addRankOne(u, A_t_j, e * u);
+          for (int col = 0; col < 3; ++col) obs.W.col(col) = u * r(col);
+          obs.V.col(0) = u;  // the factors of W for the elimination (Observation::V)
+          obs.V.col(1).head<3>() = r;
+          continue;
         }
       }
       cost += 0.5 * k.rho;
@@ -201,22 +218,58 @@ bool LocalBundleAdjuster::solveDamped(const LocalBaOptions& options, double lamb
       ++num_fixed_landmarks_;
       continue;
     }
-    // Gather the observations in free keyframes (contiguous ids), forming V = W H_ll^-1 and the
-    // reduced right-hand side on the way.
+    // Gather the observations in free keyframes (contiguous ids).
     const int* order = &observation_order_[lm.first_observation];
     int* free_obs = landmark_scratch_.data();
     int num_free = 0;
+    bool all_line_samples = true;
     for (int a = 0; a < lm.num_observations; ++a) {
       Observation& obs = observations_[order[a]];
       const int v = keyframes_[obs.keyframe].variable;
       if (!obs.valid || v < 0) continue;
-      formVAndRhs(obs.W, lm.H_point_inv, lm.g_point, &obs.V, rhs.data() + 6 * v);
+      all_line_samples = all_line_samples && obs.kind == ObservationKind::kLineSample;
       free_obs[num_free++] = order[a];
+    }
+    const Eigen::Index stride = S.outerStride();
+    auto block = [&S](int row_variable, int col_variable) { return &S(6 * row_variable, 6 * col_variable); };
+    if (all_line_samples) {
+      // W_a = u_a r_a^T, so V_a W_b^T = u_a (r_a^T H_ll^-1 r_b) u_b^T: a scaled outer product of
+      // two 6-vectors (about half the instructions of the general product); V g = u (H_ll^-1 r)^T g.
+      for (int a = 0; a < num_free; ++a) {
+        Observation& obs = observations_[free_obs[a]];
+        obs.V.col(2).head<3>().noalias() = lm.H_point_inv * obs.V.col(1).head<3>();
+        rhs.segment<6>(6 * keyframes_[obs.keyframe].variable) += obs.V.col(2).head<3>().dot(lm.g_point) * obs.V.col(0);
+      }
+      for (int a = 0; a < num_free; ++a) {
+        const Observation& obs_a = observations_[free_obs[a]];
+        const int v_a = keyframes_[obs_a.keyframe].variable;
+        const double* u_a = obs_a.V.col(0).data();
+        const Eigen::Vector3d r_a = obs_a.V.col(1).head<3>();
+        subtractScaledOuterLower(r_a.dot(obs_a.V.col(2).head<3>()), u_a, u_a, block(v_a, v_a), stride);
+        for (int b = a + 1; b < num_free; ++b) {
+          const Observation& obs_b = observations_[free_obs[b]];
+          const int v_b = keyframes_[obs_b.keyframe].variable;
+          const double gamma = r_a.dot(obs_b.V.col(2).head<3>());  // r_a^T H^-1 r_b, symmetric
+          const double* u_b = obs_b.V.col(0).data();
+          if (v_b > v_a) {
+            subtractScaledOuter(gamma, u_b, u_a, block(v_b, v_a), stride);
+          } else if (v_b < v_a) {
+            subtractScaledOuter(gamma, u_a, u_b, block(v_a, v_b), stride);
+          } else {
+            subtractScaledOuter(gamma, u_a, u_b, block(v_a, v_a), stride);
+            subtractScaledOuter(gamma, u_b, u_a, block(v_a, v_a), stride);
+          }
+        }
+      }
+      continue;
+    }
+    // V = W H_ll^-1 and the reduced right-hand side.
+    for (int a = 0; a < num_free; ++a) {
+      Observation& obs = observations_[free_obs[a]];
+      formVAndRhs(obs.W, lm.H_point_inv, lm.g_point, &obs.V, rhs.data() + 6 * keyframes_[obs.keyframe].variable);
     }
     // S_ab -= V_a W_b^T for every unordered pair sharing this landmark, written into the lower
     // block triangle (row block >= column block), which is all the Cholesky reads.
-    const Eigen::Index stride = S.outerStride();
-    auto block = [&S](int row_variable, int col_variable) { return &S(6 * row_variable, 6 * col_variable); };
     for (int a = 0; a < num_free; ++a) {
       const Observation& obs_a = observations_[free_obs[a]];
       const int v_a = keyframes_[obs_a.keyframe].variable;

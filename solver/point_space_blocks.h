@@ -37,6 +37,17 @@ class PoseNormalAccumulator {
     g_[0] += q.x(), g_[1] += q.y(), g_[2] += q.z();
     g_[3] += y * q.z() - z * q.y(), g_[4] += z * q.x() - x * q.z(), g_[5] += x * q.y() - y * q.x();
   }
+  // The same for a rank-one A^T M A = u v^T (u = c v, so the product is symmetric) and A^T q = g.
+  void addRankOne(const Vector6d& u, const Vector6d& v, const Vector6d& g) {
+    tt_[0] += u(0) * v(0), tt_[1] += u(0) * v(1), tt_[2] += u(0) * v(2);
+    tt_[3] += u(1) * v(1), tt_[4] += u(1) * v(2), tt_[5] += u(2) * v(2);
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) tr_[3 * r + c] += u(r) * v(3 + c);
+    }
+    rr_[0] += u(3) * v(3), rr_[1] += u(3) * v(4), rr_[2] += u(3) * v(5);
+    rr_[3] += u(4) * v(4), rr_[4] += u(4) * v(5), rr_[5] += u(5) * v(5);
+    for (int i = 0; i < 6; ++i) g_[i] += g(i);
+  }
   void finish(Matrix6d* H, Vector6d* g) const {
     *H << tt_[0], tt_[1], tt_[2], tr_[0], tr_[1], tr_[2],  //
         tt_[1], tt_[3], tt_[4], tr_[3], tr_[4], tr_[5],    //

@@ -110,10 +110,13 @@ NormalEquations linearize(const CameraIntrinsics& camera, const Eigen::Isometry3
     lineResidualAt(camera, P_cam, obs.line, &e, &J_cam);
     double rho = 0.0, weight = 0.0;
     robustCostAndWeight(kernels.line, e * e * obs.information, &rho, &weight);
-    const Eigen::Vector3d wj = (weight * obs.information) * J_cam.transpose();
-    const Eigen::Matrix3d M = wj * J_cam;  // rank one
-    accumulator.add(M, e * wj, P_cam);
-    if (H_map != nullptr && obs.map_share > 0) map_accumulator.add(obs.map_share * M, Eigen::Vector3d::Zero(), P_cam);
+    // Rank one: A^T M A = u (A^T j)^T with j = J_cam^T, u = w Omega A^T j.
+    const Eigen::Vector3d j = J_cam.transpose();
+    Vector6d A_t_j;
+    A_t_j << j, P_cam.cross(j);
+    const Vector6d u = (weight * obs.information) * A_t_j;
+    accumulator.addRankOne(u, A_t_j, e * u);
+    if (H_map != nullptr && obs.map_share > 0) map_accumulator.addRankOne(obs.map_share * u, A_t_j, Vector6d::Zero());
     ne.cost += 0.5 * rho;
   }
   accumulator.finish(&ne.H, &ne.g);
@@ -211,6 +214,7 @@ PoseResult optimizePose(const CameraIntrinsics& camera, const Eigen::Isometry3d&
     if (changed == 0) break;
   }
 
+  if (!options.compute_covariance) return result;
   Matrix6d H_map;
   const NormalEquations ne = linearize(camera, result.T_cam_world, points, num_points, lines, num_lines,
                                        kernels, point_inliers, line_inliers, &H_map);

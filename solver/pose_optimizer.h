@@ -52,6 +52,9 @@ struct PoseOptimizerOptions {
   // the step quality (safer from poor initial poses, a little slower).
   bool levenberg_marquardt = false;
   double initial_lambda = 1e-4;  // LM only: relative to the diagonal of H
+  // false: skip the last linearisation at the final pose, so PoseResult's covariance stays
+  // invalid and final_cost 0 (for a caller that only wants the pose and the inlier flags).
+  bool compute_covariance = true;
 };
 
 // A map point seen by the current frame. With has_depth = false only z.head<2>() = [u, v] and

@@ -1,5 +1,5 @@
 #pragma once
-// The two small products of the landmark elimination in local BA (local_ba_linearization.cpp),
+// The small products of the landmark elimination in local BA (local_ba_linearization.cpp),
 // written on 2-double vectors (GCC/Clang vector extensions: SSE2 on x86-64, NEON on aarch64).
 //
 // Why not Eigen's `S.block<6, 6>(..) -= V * W.transpose()`: GCC compiles it column by column and
@@ -62,6 +62,31 @@ inline void subtractVWtLower(const Matrix63d& V, const Matrix63d& W, double* S, 
     if (c < 2) store2(S, load2(S) - (v00 * w0 + v10 * w1 + v20 * w2));
     if (c < 4) store2(S + 2, load2(S + 2) - (v01 * w0 + v11 * w1 + v21 * w2));
     store2(S + 4, load2(S + 4) - (v02 * w0 + v12 * w1 + v22 * w2));
+  }
+}
+
+// S_block -= gamma x y^T (x, y: 6 doubles), the rank-one form of V W^T for line samples.
+inline void subtractScaledOuter(double gamma, const double* x, const double* y, double* S, Eigen::Index stride) {
+  using namespace schur_detail;
+  const Double2 x0 = load2(x), x1 = load2(x + 2), x2 = load2(x + 4);
+  for (int c = 0; c < 6; ++c, S += stride) {
+    const Double2 s = splat(gamma * y[c]);
+    store2(S, load2(S) - x0 * s);
+    store2(S + 2, load2(S + 2) - x1 * s);
+    store2(S + 4, load2(S + 4) - x2 * s);
+  }
+}
+
+// The same on a diagonal block, lower triangle only (row pairs from (c & ~1) down, as
+// subtractVWtLower).
+inline void subtractScaledOuterLower(double gamma, const double* x, const double* y, double* S, Eigen::Index stride) {
+  using namespace schur_detail;
+  const Double2 x0 = load2(x), x1 = load2(x + 2), x2 = load2(x + 4);
+  for (int c = 0; c < 6; ++c, S += stride) {
+    const Double2 s = splat(gamma * y[c]);
+    if (c < 2) store2(S, load2(S) - x0 * s);
+    if (c < 4) store2(S + 2, load2(S + 2) - x1 * s);
+    store2(S + 4, load2(S + 4) - x2 * s);
   }
 }
 

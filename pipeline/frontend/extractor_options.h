@@ -75,7 +75,7 @@ inline std::string validate(const ExtractorOptions& o) {
 // fields, this thread's CPU time (CLOCK_THREAD_CPUTIME_ID), which does not count time the thread
 // waited for a core -- the honest number on a loaded machine.
 struct ExtractorTimings {
-  double pyramid_ms = 0;   // grey conversion + pyramid + descriptor blur
+  double pyramid_ms = 0;   // grey conversion + pyramid (the descriptor blur is in orb_ms, per level)
   double orb_ms = 0;       // FAST, spreading, orientation, rBRIEF (includes pyramid_ms)
   double lines_ms = 0;     // LSD + ranking + LBD-style descriptors
   double depth_ms = 0;     // keypoint depth/noise + line samples + robust 3D fits

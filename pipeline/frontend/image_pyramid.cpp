@@ -1,5 +1,6 @@
 #include "pipeline/frontend/image_pyramid.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <utility>
@@ -7,7 +8,46 @@
 #include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
+// Byte shuffles for downsample(): SSSE3's pshufb (x86-64, chosen at run time: the baseline is
+// SSE2) or NEON's tbl (every aarch64 CPU). Elsewhere the portable gather path alone.
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <tmmintrin.h>
+#define PLUMB_PYRAMID_SHUFFLE 1
+#define PLUMB_PYRAMID_SHUFFLE_TARGET __attribute__((target("ssse3")))
+#elif defined(__aarch64__)
+#include <arm_neon.h>
+#define PLUMB_PYRAMID_SHUFFLE 1
+#define PLUMB_PYRAMID_SHUFFLE_TARGET
+#else
+#define PLUMB_PYRAMID_SHUFFLE 0
+#endif
+
 namespace plumb {
+#if PLUMB_PYRAMID_SHUFFLE
+namespace {
+
+// 16 bytes at `row`, permuted: byte i of the result is byte shuffle[i] of the input (< 16).
+PLUMB_PYRAMID_SHUFFLE_TARGET inline cv::v_int16x8 shuffleBytes(const int16_t* row, const uint8_t* shuffle) {
+#if defined(__x86_64__)
+  const __m128i bytes = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row));
+  return cv::v_int16x8(_mm_shuffle_epi8(bytes, _mm_loadu_si128(reinterpret_cast<const __m128i*>(shuffle))));
+#else
+  const uint8x16_t bytes = vld1q_u8(reinterpret_cast<const uint8_t*>(row));
+  return cv::v_int16x8(vreinterpretq_s16_u8(vqtbl1q_u8(bytes, vld1q_u8(shuffle))));
+#endif
+}
+
+bool cpuHasShuffle() {
+#if defined(__x86_64__)
+  static const bool has = __builtin_cpu_supports("ssse3");
+  return has;
+#else
+  return true;
+#endif
+}
+
+}  // namespace
+#endif
 
 ImagePyramid::ImagePyramid(int width, int height, int num_levels, float scale_factor)
     : num_levels_(num_levels < 1 ? 1 : (num_levels > kPyramidLevels ? kPyramidLevels : num_levels)) {
@@ -35,6 +75,20 @@ ImagePyramid::ImagePyramid(int width, int height, int num_levels, float scale_fa
     CV_Assert(t.index1 == t.index0 + 1 || t.weight == 0);
     x_weight_pairs_.push_back(((1 << kWeightBits) - t.weight) | (t.weight << 16));
   }
+  for (int i = 1; i < num_levels_; ++i) {
+    group_start_[i] = static_cast<int>(group_base_.size());
+    shuffle_ok_[i] = true;
+    const Tap* taps = x_taps_.data() + x_tap_start_[i];
+    for (int g = 0; g < 2 * (sizes[i].width / 8); ++g) {  // the vector loop's blocks of 8
+      const int base = taps[4 * g].index0;
+      group_base_.push_back(base);
+      for (int j = 0; j < 4; ++j) {
+        const int offset = taps[4 * g + j].index0 - base;  // element pair (offset, offset + 1)
+        if (offset < 0 || offset > 6) shuffle_ok_[i] = false;
+        for (int b = 0; b < 4; ++b) group_shuffle_.push_back(static_cast<uint8_t>(std::clamp(2 * offset + b, 0, 15)));
+      }
+    }
+  }
   const cv::Mat kernel = cv::getGaussianKernel(7, 2.0, CV_64F);
   int sum = 0;
   for (int k = 0; k < 7; ++k) sum += kernel_[k] = static_cast<int>(std::lround(kernel.at<double>(k) * 256));
@@ -55,15 +109,52 @@ ImagePyramid::ImagePyramid(int width, int height, int num_levels, float scale_fa
 }
 
 void ImagePyramid::build(const cv::Mat& grey) {
+  buildLevels(grey);
+  // 7x7, sigma 2: the smoothing rotated BRIEF is defined on.
+  for (int i = 0; i < num_levels_; ++i) blur(levels_[i], blurred_levels_[i], 0, 0, levels_[i].cols, levels_[i].rows);
+}
+
+void ImagePyramid::buildLevels(const cv::Mat& grey) {
   grey.copyTo(levels_[0]);  // levels_[0] has the right size: copyTo writes in place
   for (int i = 1; i < num_levels_; ++i) {
     // Resize from the previous level (as ORB-SLAM does): cheap, and the 1.2 step keeps
     // bilinear aliasing small.
     downsample(i);
   }
-  // 7x7, sigma 2: the smoothing rotated BRIEF is defined on.
-  for (int i = 0; i < num_levels_; ++i) blur(levels_[i], blurred_levels_[i]);
 }
+
+void ImagePyramid::blurRect(int level, int x0, int y0, int x1, int y1) {
+  blur(levels_[level], blurred_levels_[level], x0, y0, x1, y1);
+}
+
+#if PLUMB_PYRAMID_SHUFFLE
+namespace {
+
+// The horizontal pass of downsample() on whole blocks of 8 outputs, gathering the (x0, x0 + 1)
+// pairs by byte shuffles; the same integer arithmetic, so the same bytes. Returns the first
+// output column it did not write.
+PLUMB_PYRAMID_SHUFFLE_TARGET int horizontalShuffled(const int16_t* high, const int16_t* low, const int32_t* bases,
+                                                    const uint8_t* shuffles, const int32_t* weights, int cols,
+                                                    uint8_t* d) {
+  const cv::v_int32x4 round = cv::v_setall_s32(1 << 21);
+  int xd = 0;
+  for (int g = 0; xd + 8 <= cols; xd += 8, g += 2) {
+    cv::v_int32x4 sums[2];
+    for (int h = 0; h < 2; ++h) {
+      const int base = bases[g + h];
+      const uint8_t* shuffle = shuffles + 16 * (g + h);
+      const cv::v_int16x8 high_pairs = shuffleBytes(high + base, shuffle);
+      const cv::v_int16x8 low_pairs = shuffleBytes(low + base, shuffle);
+      const cv::v_int16x8 w = cv::v_reinterpret_as_s16(cv::v_load(weights + xd + 4 * h));
+      sums[h] = ((cv::v_dotprod(high_pairs, w) << 10) + cv::v_dotprod(low_pairs, w) + round) >> 22;
+    }
+    cv::v_pack_u_store(d + xd, cv::v_pack(sums[0], sums[1]));
+  }
+  return xd;
+}
+
+}  // namespace
+#endif
 
 void ImagePyramid::appendTaps(int src_size, int dst_size, std::vector<Tap>& taps) {
   const double step = static_cast<double>(src_size) / dst_size;
@@ -127,6 +218,12 @@ void ImagePyramid::downsample(int level) {
     // padding element past the row only ever meets a zero weight.
     uint8_t* d = dst.ptr<uint8_t>(y);
     int xd = 0;
+#if PLUMB_PYRAMID_SHUFFLE
+    if (shuffle_ok_[level] && cpuHasShuffle()) {
+      xd = horizontalShuffled(high, low, group_base_.data() + group_start_[level],
+                              group_shuffle_.data() + 16 * group_start_[level], x_weights, dst.cols, d);
+    }
+#endif
     for (; xd + 8 <= dst.cols; xd += 8) {
       cv::v_int32x4 sums[2];
       for (int g = 0; g < 2; ++g) {
@@ -148,56 +245,67 @@ void ImagePyramid::downsample(int level) {
   }
 }
 
-void ImagePyramid::blur(const cv::Mat& src, cv::Mat& dst) {
+void ImagePyramid::blur(const cv::Mat& src, cv::Mat& dst, int x0, int y0, int x1, int y1) {
   // Separable, vertical pass first, 8.8 fixed point: the vertical sum (<= 255 * 256) is rounded
   // back to 8 bits of range so the horizontal pass also fits 16-bit lanes (the lost fraction is far
   // below what the binary tests can see). One padded 16-bit row buffer, reflected borders.
   const int w = src.cols, h = src.rows;
+  x0 = std::max(x0, 0), y0 = std::max(y0, 0), x1 = std::min(x1, w), y1 = std::min(y1, h);
+  if (x0 >= x1 || y0 >= y1) return;
   auto reflect = [](int i, int n) { return i < 0 ? -i : (i >= n ? 2 * n - 2 - i : i); };  // REFLECT_101
+  // The vertical pass covers the columns the horizontal one reads, [x0 - 3, x1 + 3) inside the
+  // image; the 3 columns past an image edge are mirrored from inside it afterwards.
+  const int vx0 = std::max(x0 - 3, 0), vx1 = std::min(x1 + 3, w);
   uint16_t* t = row_filtered_.ptr<uint16_t>(0) + 3;  // t[-3 .. w+2] valid after padding
   const uint16_t k[7] = {uint16_t(kernel_[0]), uint16_t(kernel_[1]), uint16_t(kernel_[2]), uint16_t(kernel_[3]),
                          uint16_t(kernel_[4]), uint16_t(kernel_[5]), uint16_t(kernel_[6])};
   cv::v_uint16x8 vk[7];
   for (int i = 0; i < 7; ++i) vk[i] = cv::v_setall_u16(k[i]);
   const cv::v_uint16x8 half = cv::v_setall_u16(128);
-  for (int y = 0; y < h; ++y) {
+  // Rows of whole vector blocks; a partial last block is moved back to end at the range's end
+  // and recomputes a few columns with the same values (so a small rectangle needs no scalar tail).
+  const int v_block_end = vx1 - vx0 >= 16 ? vx1 : vx0;
+  const int h_block_end = x1 - x0 >= 8 ? x1 : x0;
+  for (int y = y0; y < y1; ++y) {
     const uint8_t* r[7];
     for (int i = 0; i < 7; ++i) r[i] = src.ptr<uint8_t>(reflect(y + i - 3, h));
-    int x = 0;
     // The kernel is symmetric: rows 3 - i and 3 + i are added first (<= 510) and multiplied
     // once, 4 multiplies instead of 7 for the same integer sum (<= 65280: no overflow).
-    for (; x + 16 <= w; x += 16) {
+    for (int x = vx0; x < v_block_end;) {
+      const int bx = std::min(x, v_block_end - 16);
+      x = bx + 16;
       cv::v_uint16x8 lo, hi, a, b;
-      cv::v_expand(cv::v_load(r[3] + x), lo, hi);
+      cv::v_expand(cv::v_load(r[3] + bx), lo, hi);
       lo = cv::v_mul_wrap(lo, vk[3]);
       hi = cv::v_mul_wrap(hi, vk[3]);
       for (int i = 0; i < 3; ++i) {
         cv::v_uint16x8 c, e;
-        cv::v_expand(cv::v_load(r[i] + x), a, b);
-        cv::v_expand(cv::v_load(r[6 - i] + x), c, e);
+        cv::v_expand(cv::v_load(r[i] + bx), a, b);
+        cv::v_expand(cv::v_load(r[6 - i] + bx), c, e);
         lo += cv::v_mul_wrap(a + c, vk[i]);
         hi += cv::v_mul_wrap(b + e, vk[i]);
       }
-      cv::v_store(t + x, (lo + half) >> 8);
-      cv::v_store(t + x + 8, (hi + half) >> 8);
+      cv::v_store(t + bx, (lo + half) >> 8);
+      cv::v_store(t + bx + 8, (hi + half) >> 8);
     }
-    for (; x < w; ++x) {
+    for (int x = v_block_end > vx0 ? vx1 : vx0; x < vx1; ++x) {
       unsigned acc = 0;
       for (int i = 0; i < 7; ++i) acc += k[i] * r[i][x];
       t[x] = static_cast<uint16_t>((acc + 128) >> 8);
     }
-    for (int i = 1; i <= 3; ++i) {
-      t[-i] = t[reflect(-i, w)];
-      t[w - 1 + i] = t[reflect(w - 1 + i, w)];
+    for (int i = 1; i <= 3; ++i) {  // the horizontal pass reads t[x0 - 3 .. x1 + 2]
+      if (x0 < 3) t[-i] = t[reflect(-i, w)];
+      if (x1 + 3 > w) t[w - 1 + i] = t[reflect(w - 1 + i, w)];
     }
     uint8_t* d = dst.ptr<uint8_t>(y);
-    x = 0;
-    for (; x + 8 <= w; x += 8) {
-      cv::v_uint16x8 acc = cv::v_mul_wrap(cv::v_load(t + x), vk[3]);
-      for (int i = 0; i < 3; ++i) acc += cv::v_mul_wrap(cv::v_load(t + x + i - 3) + cv::v_load(t + x + 3 - i), vk[i]);
-      cv::v_pack_store(d + x, (acc + half) >> 8);
+    for (int x = x0; x < h_block_end;) {
+      const int bx = std::min(x, h_block_end - 8);
+      x = bx + 8;
+      cv::v_uint16x8 acc = cv::v_mul_wrap(cv::v_load(t + bx), vk[3]);
+      for (int i = 0; i < 3; ++i) acc += cv::v_mul_wrap(cv::v_load(t + bx + i - 3) + cv::v_load(t + bx + 3 - i), vk[i]);
+      cv::v_pack_store(d + bx, (acc + half) >> 8);
     }
-    for (; x < w; ++x) {
+    for (int x = h_block_end > x0 ? x1 : x0; x < x1; ++x) {
       unsigned acc = 0;
       for (int i = 0; i < 7; ++i) acc += k[i] * t[x + i - 3];
       d[x] = static_cast<uint8_t>((acc + 128) >> 8);

@@ -24,17 +24,27 @@ class ImagePyramid {
 
   // grey: CV_8UC1 of the level-0 size. Fills every level and the blurred levels.
   void build(const cv::Mat& grey);
+  // Fills the levels only; blurRect() then blurs just the parts a caller reads (ORB blurs the
+  // neighbourhoods of the keypoints it describes: ~half of the pixels on fr1/rpy). A blurred
+  // pixel has the same value either way; pixels never blurred keep older contents.
+  void buildLevels(const cv::Mat& grey);
+  // Blurs [x0, x1) x [y0, y1) of `level` (clipped to the level) into blurred(level).
+  void blurRect(int level, int x0, int y0, int x1, int y1);
 
   int numLevels() const { return num_levels_; }
   float scale(int level) const { return scales_[level]; }  // scale_factor^level
   const cv::Mat& level(int i) const { return levels_[i]; }
   const cv::Mat& blurred(int i) const { return blurred_levels_[i]; }
   int stride() const { return static_cast<int>(buffer_.step[0]); }  // bytes per row, every level
+  // Whether downsample() can gather level i's bilinear pairs by byte shuffles (tests).
+  bool shuffleGatherPossible(int level) const { return shuffle_ok_[level]; }
 
  private:
   int num_levels_;
   std::array<float, kPyramidLevels> scales_{};
-  void blur(const cv::Mat& src, cv::Mat& dst);
+  // The separable 7-tap blur of src on [x0, x1) x [y0, y1) into dst, borders reflected at the
+  // image edges (not at the rectangle's): every pixel gets the value a whole-image pass gives.
+  void blur(const cv::Mat& src, cv::Mat& dst, int x0, int y0, int x1, int y1);
   void downsample(int level);  // levels_[level - 1] -> levels_[level], bilinear
 
   // Bilinear sampling table of one axis of one level: source index and the 11-bit fixed-point
@@ -50,6 +60,15 @@ class ImagePyramid {
   std::array<int, kPyramidLevels> x_tap_start_{}, y_tap_start_{};  // each level's first entry
   std::vector<int32_t> x_weight_pairs_;  // per x tap: (2048 - weight) | weight << 16, two int16 lanes
   cv::Mat high_row_, low_row_;      // CV_16SC1, one source row + padding: the vertical pass, split
+  // Byte-shuffle form of the horizontal pass (x86-64 with SSSE3, aarch64): the four (x0, x0 + 1)
+  // pairs of 4 consecutive outputs lie within 8 source elements (scale 1.2: ~5.8), so one 16-byte
+  // load at the group's first index0 and one byte shuffle replace 4 scalar loads. Per group of 4
+  // outputs of the vector loop: that index and the shuffle's 16 byte indices. shuffle_ok_ is
+  // false for a level whose taps spread further (larger scale factors): the scalar-gather path.
+  std::vector<int32_t> group_base_;
+  std::vector<uint8_t> group_shuffle_;
+  std::array<int, kPyramidLevels> group_start_{};
+  std::array<bool, kPyramidLevels> shuffle_ok_{};
 
   cv::Mat buffer_, blurred_buffer_;
   cv::Mat row_filtered_;            // CV_16UC1, one row + 3 px padding each side: the blur's vertical pass

@@ -1,6 +1,8 @@
 #include "pipeline/frontend/orb_descriptor.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
 #include <opencv2/core/hal/intrin.hpp>
 
@@ -57,6 +59,7 @@ OrbDescriber::OrbDescriber(int stride) : stride_(stride) {
       const double x = pattern[2 * i], y = pattern[2 * i + 1];
       const int rx = static_cast<int>(std::lround(c * x - s * y));
       const int ry = static_cast<int>(std::lround(s * x + c * y));
+      sample_reach_ = std::max(sample_reach_, std::max(std::abs(rx), std::abs(ry)));
       // Test i compares sample 2i (first) with sample 2i + 1 (second).
       (i % 2 == 0 ? first_offsets_ : second_offsets_)[bin][i / 2] = ry * stride_ + rx;
     }

@@ -27,9 +27,13 @@ class OrbDescriber {
   float orientationDeg(const uint8_t* p) const;
   // Rotated BRIEF on the blurred level at `p`.
   void describe(const uint8_t* p_blurred, float angle_deg, Descriptor256& out) const;
+  // The farthest any test sample lies from the keypoint along x or y, over every orientation
+  // bin (pixels): describe() reads the blurred level only within this square.
+  int sampleReach() const { return sample_reach_; }
 
  private:
   int stride_;
+  int sample_reach_ = 0;
   std::array<int, kPatchRadius + 1> disc_half_width_{};  // half row width of the disc at dy
   // [bin][bit]: byte offsets of the first and the second sample of each test.
   std::array<std::array<int, 256>, kAngleBins> first_offsets_{}, second_offsets_{};

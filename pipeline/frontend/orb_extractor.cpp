@@ -23,6 +23,7 @@ OrbExtractor::OrbExtractor(const PinholeCamera& camera, const ExtractorOptions& 
   rank_start_.resize(kMaxCornersPerLevel + 1);
   cell_has_corner_.resize(static_cast<size_t>(camera.width / 8 + 1) * (camera.height / 8 + 1));
   cell_start_.resize(cell_has_corner_.size() + 1);
+  blur_tile_needed_.resize(static_cast<size_t>(camera.width / kBlurTile + 1) * (camera.height / kBlurTile + 1));
   // Geometric share per level: n0 * (1/s)^i, summing to num_features (ORB-SLAM's split).
   const int levels = pyramid_.numLevels();
   const double inv = 1.0 / options.scale_factor;
@@ -37,7 +38,7 @@ OrbExtractor::OrbExtractor(const PinholeCamera& camera, const ExtractorOptions& 
 
 void OrbExtractor::extract(const cv::Mat& grey, FrameFeatures& out) {
   const auto t0 = std::chrono::steady_clock::now();
-  pyramid_.build(grey);
+  pyramid_.buildLevels(grey);  // each level's blur comes in selectOnLevel, where BRIEF reads it
   pyramid_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   int carry = 0;  // features a level could not provide move to the next one
   const int max_total = std::min<int>(options_.num_features, kMaxKeypoints);
@@ -121,6 +122,8 @@ void OrbExtractor::selectOnLevel(int level, int wanted, FrameFeatures& out) {
     first = end;
   }
 
+  blurAroundKeypoints(level, take);
+
   const float scale = pyramid_.scale(level);
   const uint8_t* level_origin = image.ptr<uint8_t>(0);
   const uint8_t* blurred_origin = pyramid_.blurred(level).ptr<uint8_t>(0);
@@ -153,6 +156,35 @@ void OrbExtractor::selectOnLevel(int level, int wanted, FrameFeatures& out) {
     kp->px_undist = camera_.undistortPoint(kp->px.x(), kp->px.y()).cast<float>();
     kp->response = c.score;
     kp->octave = static_cast<int8_t>(level);
+  }
+}
+
+void OrbExtractor::blurAroundKeypoints(int level, int take) {
+  // Marks the tiles holding a sample of some keypoint's BRIEF tests, then blurs each row of tiles
+  // in runs of consecutive marked tiles. The tiles are small enough that a 32 px cell's keypoint
+  // does not drag in much more than its own neighbourhood.
+  const cv::Mat& image = pyramid_.level(level);
+  const int tile_cols = (image.cols + kBlurTile - 1) / kBlurTile, tile_rows = (image.rows + kBlurTile - 1) / kBlurTile;
+  char* needed = blur_tile_needed_.data();
+  std::fill_n(needed, static_cast<size_t>(tile_cols) * tile_rows, 0);
+  const int reach = describer_.sampleReach();
+  for (int i = 0; i < take; ++i) {
+    const FastCorner& c = by_rank_[i].corner;
+    const int tx0 = std::max(c.x - reach, 0) / kBlurTile, tx1 = std::min(c.x + reach, image.cols - 1) / kBlurTile;
+    const int ty0 = std::max(c.y - reach, 0) / kBlurTile, ty1 = std::min(c.y + reach, image.rows - 1) / kBlurTile;
+    for (int ty = ty0; ty <= ty1; ++ty) std::fill(needed + ty * tile_cols + tx0, needed + ty * tile_cols + tx1 + 1, 1);
+  }
+  for (int ty = 0; ty < tile_rows; ++ty) {
+    const char* row = needed + ty * tile_cols;
+    for (int tx = 0; tx < tile_cols;) {
+      if (!row[tx]) {
+        ++tx;
+        continue;
+      }
+      const int run_start = tx;
+      while (tx < tile_cols && row[tx]) ++tx;
+      pyramid_.blurRect(level, run_start * kBlurTile, ty * kBlurTile, tx * kBlurTile, (ty + 1) * kBlurTile);
+    }
   }
 }
 

@@ -40,6 +40,9 @@ class OrbExtractor {
   };
 
   void selectOnLevel(int level, int wanted, FrameFeatures& out);
+  // Blurs the parts of `level` the descriptors of its first `take` ranked corners read.
+  void blurAroundKeypoints(int level, int take);
+  static constexpr int kBlurTile = 8;  // px, square: 8 blurs ~7 % fewer pixels than 16 on fr1/rpy
 
   PinholeCamera camera_;
   ExtractorOptions options_;
@@ -56,6 +59,7 @@ class OrbExtractor {
   std::vector<int> cell_start_;
   std::vector<int, ZeroPageAllocator<int>> rank_start_;
   std::vector<char> cell_has_corner_;  // per spreading cell of the current level (sized for 8 px cells)
+  std::vector<char> blur_tile_needed_;  // per kBlurTile tile of the current level
   double pyramid_ms_ = 0;
 };
 

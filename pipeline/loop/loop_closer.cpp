@@ -285,21 +285,29 @@ void LoopCloser::detect(const LoopKeyframe& query_record, int query_position) {
   }
 }
 
-double LoopCloser::plausibilityChi2(int candidate_position, int query_position, const LoopMeasurement& m,
-                                    double* correction_m, double* correction_deg) const {
-  const Node& c = nodes_[std::size_t(order_[std::size_t(candidate_position)])];
+Matrix6d LoopCloser::odometryCovariance(int candidate_position, int query_position, bool drift_prior) const {
   const Node& q = nodes_[std::size_t(order_[std::size_t(query_position)])];
   const Eigen::Isometry3d T_cam_q_world = q.T_world_cam.inverse();
-  Matrix6d sigma = 0.5 * (m.covariance + m.covariance.transpose());
+  Matrix6d sigma = Matrix6d::Zero();
   for (int p = candidate_position + 1; p <= query_position; ++p) {
     const Node& j = nodes_[std::size_t(order_[std::size_t(p)])];
-    const double len = j.edge_length_m;
+    const double len = drift_prior ? j.edge_length_m : 0.0;
     const Matrix6d edge = j.edge_covariance + diagonalCovariance(options_.drift_translation_per_m * len,
                                                                  options_.drift_rotation_rad_per_m * len);
     const Matrix6d Ad = adjointSE3(T_cam_q_world * j.T_world_cam);  // T_q_j
     sigma += Ad * edge * Ad.transpose();
   }
-  sigma += diagonalCovariance(options_.floor_translation_sigma_m, options_.floor_rotation_sigma_rad);
+  return sigma;
+}
+
+double LoopCloser::plausibilityChi2(int candidate_position, int query_position, const LoopMeasurement& m,
+                                    double* correction_m, double* correction_deg) const {
+  const Node& c = nodes_[std::size_t(order_[std::size_t(candidate_position)])];
+  const Node& q = nodes_[std::size_t(order_[std::size_t(query_position)])];
+  const Eigen::Isometry3d T_cam_q_world = q.T_world_cam.inverse();
+  const Matrix6d sigma = 0.5 * (m.covariance + m.covariance.transpose()) +
+                        odometryCovariance(candidate_position, query_position, true) +
+                        diagonalCovariance(options_.floor_translation_sigma_m, options_.floor_rotation_sigma_rad);
   const Vector6d e = poseGraphEdgeError(m.T_candidate_query, c.T_world_cam.inverse(), T_cam_q_world);
   // The query's current pose seen from where the loop puts it: how far the correction moves it.
   const Eigen::Isometry3d E = m.T_candidate_query.inverse() * c.T_world_cam.inverse() * q.T_world_cam;
@@ -367,7 +375,25 @@ void LoopCloser::optimise() {
     const int c = findPosition(loop_edges_.back().candidate_id);
     if (c >= 0) {
       const Node& candidate = nodes_[std::size_t(order_[std::size_t(c)])];
-      correction_.T_world_cam = candidate.T_world_record * loop_edges_.back().T_candidate_query;
+      const LoopEdge& edge = loop_edges_.back();
+      const Eigen::Isometry3d T_world_loop = candidate.T_world_record * edge.T_candidate_query;
+      correction_.T_world_cam = T_world_loop;
+      if (options_.fuse_realtime_correction) {
+        // Minimum-variance update of the query's pose as the robot has it (T_odo: its record) with
+        // the loop (T_loop): d = log(T_cw(loop) T_cw(odo)^-1) is the full correction, in the
+        // query frame; the odometry from the candidate to the query is uncertain by S_odo (the
+        // calibrated edge covariances along the graph), the loop by S_loop, so the query moves by
+        // K d, K = S_odo (S_odo + S_loop)^-1: all the way when the loop is far more certain than
+        // the drift (K ~ I), halfway when both are alike, instead of jumping by the loop's own
+        // error where there was little drift to remove.
+        const Matrix6d S_odo = odometryCovariance(c, int(order_.size()) - 1, false);
+        const Matrix6d S_loop = inverseSpd(edge.information);
+        const Matrix6d K = S_odo * inverseSpd(S_odo + S_loop);
+        const Eigen::Isometry3d T_cw_odo = query.T_world_record.inverse();
+        const Vector6d d = logSE3(T_world_loop.inverse() * query.T_world_record);
+        const Vector6d step = K * d;
+        if (step.allFinite()) correction_.T_world_cam = applyLeftIncrement(step, T_cw_odo).inverse();
+      }
     }
   }
   const double ms =

@@ -17,7 +17,9 @@
 //      (S_j: edge covariances; drift_j: a prior proportional to the distance travelled.) Repeated
 //      texture typically implies a jump of a whole module that this test refuses.
 //   5. a loop edge (Huber kernel), pose-graph LM (solver/pose_graph.h), and a MapCorrection for
-//      the query keyframe (its optimised pose) for the mapping side.
+//      the query keyframe for the mapping side: its pose as the robot had it moved towards where
+//      the loop puts it relative to the candidate, by the minimum-variance share of the
+//      correction (fuse_realtime_correction; docs/LOOP.md "What the robot receives").
 // Lifelong bound: when `capacity` records are held, the most redundant keyframe (smallest distance
 // to its two graph neighbours; not the first, the newest, or one with a loop edge) is culled: its two
 // odometry edges are composed into one (covariances propagated), it leaves the database.
@@ -75,10 +77,13 @@ struct LoopCloserOptions {
   // correct loop made the optimised trajectory worse").
   double odometry_floor_translation_sigma_m = 1e-4;
   double odometry_floor_rotation_sigma_rad = 1e-4;
-  // Added to the loop edge's covariance (the verifier's, not calibrated: it holds the candidate's
-  // points exact) and to the plausibility test's sum.
-  double floor_translation_sigma_m = 0.003;
-  double floor_rotation_sigma_rad = 0.002;
+  // Added to the loop edge's covariance and to the plausibility test's sum: numerical only, like
+  // the odometry edges'. The verifier's covariance is calibrated (both ends' noise propagated,
+  // variance factor, rolling-shutter error of both images: docs/LOOP.md "The loop constraint's
+  // covariance"); until issue 20 it held the candidate's points exact and a 3 mm / 0.002 rad model
+  // floor stood in for what it missed.
+  double floor_translation_sigma_m = 1e-4;
+  double floor_rotation_sigma_rad = 1e-4;
   // The first keyframe of a new map segment: the tracker restarted at its last known pose.
   double segment_translation_sigma_m = 1.0;
   double segment_rotation_sigma_rad = 0.5;
@@ -94,6 +99,11 @@ struct LoopCloserOptions {
   // that uncertain can only add noise to drift of the same size.
   double max_loop_sigma_m = 0.03;
   double max_loop_sigma_rad = 0.0175;  // 1 deg
+  // The real-time correction (docs/LOOP.md "What the robot receives"): true, the query keyframe
+  // moves by the minimum-variance share K = S_odo (S_odo + S_loop)^-1 of the correction the loop
+  // implies (S_odo: the calibrated odometry covariance from the candidate to the query, no drift
+  // prior); false, all the way to where the loop puts it.
+  bool fuse_realtime_correction = true;
   double loop_huber_delta = 2.8;  // whitened (sqrt chi-square); ~95% of a 6-dof inlier's chi
   // Do no harm: after the graph is optimised with a new loop, the covisible landmarks of the
   // keyframes around both sides must be explained at least as well as before, or the loop is
@@ -200,6 +210,10 @@ class LoopCloser {
   void cullOne();
   void detect(const LoopKeyframe& query_record, int query_position);
   // The plausibility chi-square of the loop (step 4) and the correction it implies.
+  // Covariance of the query's pose relative to the candidate accumulated along the odometry edges
+  // between them, in the query frame; with `drift_prior` each edge adds the plausibility test's
+  // prior proportional to its length.
+  Matrix6d odometryCovariance(int candidate_position, int query_position, bool drift_prior) const;
   double plausibilityChi2(int candidate_position, int query_position, const LoopMeasurement& m,
                           double* correction_m, double* correction_deg) const;
   void optimise();

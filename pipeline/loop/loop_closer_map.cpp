@@ -17,20 +17,23 @@ bool positiveDefinite(const Matrix6d& m) {
 }
 
 // The closer keeps only a keyframe's LoopCandidate (what verification and relocalization read):
-// the record written to a map file carries those features; the query-only fields (pixel, u_right,
-// octave, the 2D line) are written as zero and the record's header from the graph node.
+// the record written to a map file carries those features and their octaves; the query-only
+// fields (pixel, u_right, the 2D line) are written as zero and the record's header from the graph
+// node. (A map written before the octaves were kept has zeros there: octave 0, the finest noise.)
 void recordOfCandidate(const LoopCandidate& c, LoopKeyframe* r) {
   r->clearFeatures();
   r->id = c.id;
   for (std::size_t k = 0; k < c.num_points; ++k) {
     LoopPoint p;
     p.P_cam = c.P_cam[k];
+    p.octave = c.point_octave[k];
     (void)r->points.push_back(p);
     (void)r->point_descriptors.push_back(c.point_descriptors[k]);
   }
   for (std::size_t k = 0; k < c.num_lines; ++k) {
     LoopLine line;
     line.num_samples = c.num_samples[k];
+    line.octave = c.line_octave[k];
     for (std::size_t s = 0; s < line.num_samples; ++s) line.samples_cam[s] = c.samples_cam[c.first_sample[k] + s];
     (void)r->lines.push_back(line);
     (void)r->line_descriptors.push_back(c.line_descriptors[k]);

@@ -49,6 +49,7 @@ void makeLoopCandidate(const LoopKeyframe& r, LoopCandidate* out) {
   for (std::size_t k = 0; k < r.points.size(); ++k) {
     out->point_descriptors[k] = r.point_descriptors[k];
     out->P_cam[k] = r.points[k].P_cam;
+    out->point_octave[k] = r.points[k].octave;
   }
   out->num_lines = uint16_t(r.lines.size());
   uint16_t next = 0;
@@ -56,6 +57,7 @@ void makeLoopCandidate(const LoopKeyframe& r, LoopCandidate* out) {
     const LoopLine& line = r.lines[k];
     out->line_descriptors[k] = r.line_descriptors[k];
     out->num_samples[k] = line.num_samples;
+    out->line_octave[k] = line.octave;
     out->first_sample[k] = next;
     for (std::size_t s = 0; s < line.num_samples; ++s) out->samples_cam[next++] = line.samples_cam[s];
   }

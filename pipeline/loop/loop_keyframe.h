@@ -80,7 +80,8 @@ struct LoopKeyframe {
 // What the LoopCloser stores of a record once the record has been queried: a keyframe is verified
 // as the QUERY only when it arrives (the full LoopKeyframe is at hand then) and later only as a
 // CANDIDATE, for which LoopVerifier::verify reads the point descriptors and 3D points and the line
-// descriptors and line-guidance samples, nothing else. The samples of all lines share one array
+// descriptors and line-guidance samples, and the octaves of both (the pixel noise of the 3D points
+// and samples, propagated into the loop's covariance), nothing else. The samples of all lines share one array
 // (line k's are [first_sample[k], first_sample[k] + num_samples[k])). Values are copied, not
 // converted: verification against a LoopCandidate is bit-identical to the full record.
 // 37.5 KB against 47.4 KB for the full record (docs/LOOP.md "Memory").
@@ -90,8 +91,10 @@ struct LoopCandidate {
   uint16_t num_lines = 0;
   std::array<Descriptor256, kMaxLoopPoints> point_descriptors{};
   std::array<Eigen::Vector3f, kMaxLoopPoints> P_cam{};  // camera frame
+  std::array<int8_t, kMaxLoopPoints> point_octave{};
   std::array<Descriptor256, kMaxLoopLines> line_descriptors{};
   std::array<uint8_t, kMaxLoopLines> num_samples{};
+  std::array<int8_t, kMaxLoopLines> line_octave{};
   std::array<uint16_t, kMaxLoopLines> first_sample{};
   std::array<Eigen::Vector3f, kMaxLoopLines * kMaxLineSamples> samples_cam{};  // camera frame
 };

@@ -5,7 +5,10 @@
 #include <cmath>
 
 #include "pipeline/frontend/descriptor_match.h"
+#include "solver/factors.h"
 #include "solver/pose_optimizer.h"
+#include "solver/se3_jacobians.h"
+#include "solver/variance_factor.h"
 
 namespace plumb::loop {
 
@@ -35,6 +38,7 @@ struct LoopVerifier::Scratch {
   std::array<uint16_t, kMaxLoopPoints> query_index{};  // per match
   std::array<Eigen::Vector3d, kMaxLoopPoints> from{};  // query camera
   std::array<Eigen::Vector3d, kMaxLoopPoints> to{};    // candidate camera
+  std::array<int8_t, kMaxLoopPoints> candidate_octave{};
   std::array<bool, kMaxLoopPoints> ransac_scratch{};
   std::array<bool, kMaxLoopPoints> inlier{};
   std::array<PosePointObservation, kMaxLoopPoints> pose_points{};
@@ -42,6 +46,17 @@ struct LoopVerifier::Scratch {
   std::array<PoseLineObservation, kMaxLoopLines * kMaxLineSamples> pose_lines{};
   std::array<bool, kMaxLoopLines * kMaxLineSamples> pose_line_inlier{};
 };
+
+Eigen::Matrix3d LoopVerifier::candidateCovarianceInQuery(const Eigen::Vector3d& P_candidate, int octave,
+                                                         const Eigen::Isometry3d& T_query_candidate) const {
+  const double z = P_candidate.z();
+  if (!options_.propagate_candidate_noise || !(z >= noise_.min_depth)) return Eigen::Matrix3d::Zero();
+  // The candidate's pixel, from its 3D point (its own back-projection).
+  const double u = camera_.fx * P_candidate.x() / z + camera_.cx;
+  const double v = camera_.fy * P_candidate.y() / z + camera_.cy;
+  const Eigen::Matrix3d R = T_query_candidate.linear();
+  return R * backProjectedPointCovariance(noise_, camera_, u, v, z, octave) * R.transpose();
+}
 
 LoopVerifier::LoopVerifier(const CameraIntrinsics& camera, const NoiseModelOptions& noise,
                            const LoopVerifierOptions& options)
@@ -82,6 +97,25 @@ bool LoopVerifier::lineAgrees(const LoopLine& query_line, const Eigen::Vector3f*
   return overlap && double(close) >= options_.line_gate_min_fraction * double(count);
 }
 
+Matrix6d LoopVerifier::calibratedCovariance(const PoseResult& pose, const PoseOptimizerOptions& pose_options) const {
+  if (!options_.calibrate_covariance) return pose.covariance;
+  const UncertaintyOptions& u = options_.uncertainty;
+  // Variance factor of the point residuals only: a line's N samples carry 1/N of a sample's
+  // information each (options above), so their chi2 is not a unit-variance measurement's.
+  InlierChi2Sums points = pose.inlier_chi2;
+  points.chi2[0] = 0;
+  points.count[0] = 0;
+  const double variance_factor = u.use_variance_factor ? varianceFactor(points, 6.0, pose_options.chi2) : 1.0;
+  Matrix6d covariance = variance_factor * u.loop_scale * pose.covariance;
+  // Each image's rolling-shutter error: the query's directly, the candidate's through
+  // Ad(T_query_candidate) (a left perturbation of the candidate's pose moves T_query_candidate by
+  // -Ad(T_query_candidate) of it).
+  const Matrix6d rolling_shutter = rollingShutterCovariance(u, options_.rolling_shutter_readout_s);
+  const Matrix6d A = adjointSE3(pose.T_cam_world);
+  covariance += rolling_shutter + A * rolling_shutter * A.transpose();
+  return covariance;
+}
+
 LoopMeasurement LoopVerifier::verify(const LoopKeyframe& query, const LoopCandidate& candidate) {
   LoopMeasurement m;
   Scratch& s = *s_;
@@ -94,6 +128,7 @@ LoopMeasurement LoopVerifier::verify(const LoopKeyframe& query, const LoopCandid
     s.query_index[std::size_t(n)] = uint16_t(k);
     s.from[std::size_t(n)] = query.points[k].P_cam.cast<double>();
     s.to[std::size_t(n)] = candidate.P_cam[std::size_t(j)].cast<double>();
+    s.candidate_octave[std::size_t(n)] = candidate.point_octave[std::size_t(j)];
     ++n;
   }
   m.matches = n;
@@ -112,11 +147,15 @@ LoopMeasurement LoopVerifier::verify(const LoopKeyframe& query, const LoopCandid
     return m;
   }
 
-  // 3. Refinement: candidate camera = "world", query = the camera being posed.
+  // 3. Refinement: candidate camera = "world", query = the camera being posed. Each residual's
+  // information is the inverse of the query observation's covariance plus the candidate point's,
+  // carried through the projection at the RANSAC pose (options: propagate_candidate_noise).
+  const Eigen::Isometry3d T_qc = T_cq.inverse();
   int num_points = 0;
   for (int i = 0; i < n; ++i) {
     if (!s.inlier[std::size_t(i)]) continue;
-    const LoopPoint& q = query.points[s.query_index[std::size_t(i)]];
+    const uint16_t k = s.query_index[std::size_t(i)];
+    const LoopPoint& q = query.points[k];
     PosePointObservation& obs = s.pose_points[std::size_t(num_points++)];
     obs.P_world = s.to[std::size_t(i)];
     obs.has_depth = true;
@@ -127,10 +166,24 @@ LoopMeasurement LoopVerifier::verify(const LoopKeyframe& query, const LoopCandid
       obs.information.setZero();
       obs.information.topLeftCorner<2, 2>() = monoPointInformation(noise_, q.octave);
     }
+    const Eigen::Vector3d X = T_qc * obs.P_world;
+    const Eigen::Matrix3d S_X = candidateCovarianceInQuery(obs.P_world, s.candidate_octave[std::size_t(i)], T_qc);
+    if (!(X.z() > kFactorMinDepth) || !(S_X.trace() > 0)) continue;
+    if (obs.has_depth) {
+      Eigen::Vector3d e;
+      Eigen::Matrix3d J;
+      stereoResidualAt(camera_, X, obs.z, &e, &J);
+      obs.information = (obs.information.inverse() + J * S_X * J.transpose()).inverse();
+    } else {
+      Eigen::Vector2d e;
+      Matrix23d J;
+      monoResidualAt(camera_, X, obs.z.head<2>(), &e, &J);
+      obs.information.topLeftCorner<2, 2>() =
+          (obs.information.topLeftCorner<2, 2>().inverse() + J * S_X * J.transpose()).inverse();
+    }
   }
   int num_lines = 0;
   if (options_.use_lines) {
-    const Eigen::Isometry3d T_qc = T_cq.inverse();
     for (std::size_t k = 0; k < query.lines.size(); ++k) {
       const int j =
           bestRatioMatch(query.line_descriptors[k], candidate.line_descriptors.data(), candidate.num_lines,
@@ -141,13 +194,22 @@ LoopMeasurement LoopVerifier::verify(const LoopKeyframe& query, const LoopCandid
       const LoopLine& q = query.lines[k];
       if (!lineAgrees(q, &candidate.samples_cam[first], count, T_qc)) continue;
       ++m.line_matches;
-      const double information = lineSampleInformation(noise_, q.octave) /
-                                 (options_.line_information_per_line ? double(count) : 1.0);
+      const double per_line = options_.line_information_per_line ? double(count) : 1.0;
+      const double query_variance = 1.0 / lineSampleInformation(noise_, q.octave);
       for (std::size_t smp = 0; smp < count; ++smp) {
         PoseLineObservation& obs = s.pose_lines[std::size_t(num_lines++)];
         obs.P_world = candidate.samples_cam[first + smp].cast<double>();
         obs.line = q.l.cast<double>();
-        obs.information = information;
+        double variance = query_variance;
+        const Eigen::Vector3d X = T_qc * obs.P_world;
+        if (X.z() > kFactorMinDepth) {
+          double e = 0;
+          Eigen::RowVector3d J;
+          lineResidualAt(camera_, X, obs.line, &e, &J);
+          variance += J * candidateCovarianceInQuery(obs.P_world, candidate.line_octave[std::size_t(j)], T_qc) *
+                      J.transpose();
+        }
+        obs.information = 1.0 / (variance * per_line);
       }
     }
   }
@@ -162,7 +224,7 @@ LoopMeasurement LoopVerifier::verify(const LoopKeyframe& query, const LoopCandid
     return m;
   }
   m.T_candidate_query = pose.T_cam_world.inverse();
-  m.covariance = pose.covariance;
+  m.covariance = calibratedCovariance(pose, pose_options);
   m.rejection = LoopRejection::kNone;
   return m;
 }

@@ -17,8 +17,10 @@
 #include <memory>
 
 #include "pipeline/loop/loop_keyframe.h"
+#include "pipeline/odometry/uncertainty_options.h"
 #include "solver/camera_intrinsics.h"
 #include "solver/noise_model.h"
+#include "solver/pose_optimizer.h"
 #include "solver/rigid_fit.h"
 #include "solver/types.h"
 
@@ -46,6 +48,20 @@ struct LoopVerifierOptions {
   int min_inliers = 35;           // RANSAC inliers
   double min_inlier_ratio = 0.3;  // RANSAC inliers / matches
   int min_refined_inliers = 35;   // point inliers after refinement
+  // The loop constraint's covariance (docs/LOOP.md "The loop constraint's covariance"). Both
+  // ends of a loop are measurements: the candidate's 3D points and line samples come from its own
+  // pixels and depth, as noisy as the query's. With `propagate_candidate_noise` each residual's
+  // covariance is the query observation's PLUS the candidate point's back-projection covariance
+  // (paper eqs. 26-28: pixel sigma by octave, depth sigma 0.0015 d^2) carried through the
+  // projection, in the refinement's weights and so in its Hessian; off, the candidate is exact.
+  bool propagate_candidate_noise = true;
+  // Then calibrated like every published covariance (pipeline/odometry/uncertainty_options.h):
+  // scaled by the refinement's a posteriori variance factor (its point residuals) when
+  // `uncertainty.use_variance_factor`, and the rolling-shutter model error of EACH of the two
+  // keyframe images added (zero for a global-shutter camera), as for a BA relative pose.
+  bool calibrate_covariance = true;
+  UncertaintyOptions uncertainty;        // the system's (the loop stage copies it in)
+  double rolling_shutter_readout_s = 0;  // the camera's (the loop stage copies it in)
 };
 
 enum class LoopRejection : uint8_t {
@@ -93,6 +109,12 @@ class LoopVerifier {
   // The gate of a line match (options above), at the RANSAC pose.
   bool lineAgrees(const LoopLine& query_line, const Eigen::Vector3f* candidate_samples, std::size_t count,
                   const Eigen::Isometry3d& T_query_candidate) const;
+  // Covariance of a candidate point (its pixel noise by octave, its depth noise) in the query
+  // camera; zero when propagation is off or the depth is invalid.
+  Eigen::Matrix3d candidateCovarianceInQuery(const Eigen::Vector3d& P_candidate, int octave,
+                                             const Eigen::Isometry3d& T_query_candidate) const;
+  // The refinement's covariance, calibrated (options above).
+  Matrix6d calibratedCovariance(const PoseResult& pose, const PoseOptimizerOptions& pose_options) const;
   struct Scratch;
   CameraIntrinsics camera_;
   NoiseModelOptions noise_;

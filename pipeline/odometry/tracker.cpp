@@ -130,7 +130,8 @@ TrackResult Tracker::track(const FrameFeatures& input, uint64_t sequence, double
   // now projects its start onto SO(3), so the converged pose no longer depends on the start.)
   Eigen::Isometry3d T_cam_world = T_cam_world_pred;
   if (matches >= 6) {
-    const PoseResult pose = optimizeAndPrune(frame, T_cam_world_pred, &result);
+    // Only its pose and inliers are used (for the local-map search): no covariance.
+    const PoseResult pose = optimizeAndPrune(frame, T_cam_world_pred, &result, /*final_pose=*/false);
     T_cam_world = pose.T_cam_world;
   }
 

@@ -95,8 +95,10 @@ class Tracker {
   int matchLocalMap(const FrameFeatures& frame, const Eigen::Isometry3d& T_cam_world);
   void clearAssociations(const FrameFeatures& frame);
   // tracker_pose.cpp: optimise from T_cam_world, drop outlier associations, count inliers.
+  // final_pose = false (the first optimisation, on the last frame's matches): no covariance (one
+  // linearisation fewer). (A looser step tolerance there, 1e-4, moved head250's ATE by +14 %.)
   PoseResult optimizeAndPrune(const FrameFeatures& frame, const Eigen::Isometry3d& T_cam_world,
-                              TrackResult* result);
+                              TrackResult* result, bool final_pose = true);
   // 1 / (keyframes that measured the landmark at local_index of the snapshot; 1 when unknown).
   double mapShare(int local_index, bool point) const;
   // The tracked pose's published covariances (TrackResult) from the final optimisation.

@@ -20,7 +20,7 @@ double Tracker::mapShare(int local_index, bool point) const {
 }
 
 PoseResult Tracker::optimizeAndPrune(const FrameFeatures& frame, const Eigen::Isometry3d& T_cam_world,
-                                     TrackResult* result) {
+                                     TrackResult* result, bool final_pose) {
   const NoiseModelOptions& noise = options_.extractor.noise;
   auto& points = b_->pose_points;
   auto& point_keypoint = b_->pose_point_keypoint;
@@ -68,9 +68,11 @@ PoseResult Tracker::optimizeAndPrune(const FrameFeatures& frame, const Eigen::Is
     }
   }
 
+  PoseOptimizerOptions options = pose_options_;
+  options.compute_covariance = final_pose;
   const PoseResult pose =
       optimizePose(intrinsics_, T_cam_world, points.data(), int(points.size()), lines.data(),
-                   int(lines.size()), pose_options_, b_->point_inlier.data(), b_->line_inlier.data());
+                   int(lines.size()), options, b_->point_inlier.data(), b_->line_inlier.data());
 
   // Outliers lose their association (they are not used again for this frame nor carried on).
   result->point_inliers = 0;

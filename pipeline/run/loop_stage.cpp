@@ -10,6 +10,9 @@ loop::LoopCloserOptions withSystemNoise(const loop::LoopCloserOptions& options,
                                         const OdometrySystem& system) {
   loop::LoopCloserOptions o = options;
   o.verifier.use_lines = o.verifier.use_lines && system.options().odometry.tracker.use_lines;
+  // The loop constraint's covariance is calibrated like the odometry's (docs/UNCERTAINTY.md).
+  o.verifier.uncertainty = system.options().odometry.uncertainty;
+  o.verifier.rolling_shutter_readout_s = system.camera().rolling_shutter_readout_s;
   return o;
 }
 

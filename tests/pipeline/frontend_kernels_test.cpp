@@ -106,6 +106,49 @@ TEST(FrontendKernels, PyramidEqualsExactBilinearAndFixedPointBlur) {
   EXPECT_EQ(pyramid.level(7).cols, static_cast<int>(std::lround(643 / std::pow(1.2f, 7.f))));
 }
 
+TEST(FrontendKernels, PyramidEqualsExactBilinearWithAndWithoutShuffleGather) {
+  // Scale 1.2 (the default) and 1.5 take the byte-shuffle gather on x86-64 with SSSE3 and on
+  // aarch64; 2.5 spreads 4 outputs over more than 8 source pixels and takes the portable path.
+  const cv::Mat img = testImage(517, 389, 14);
+  for (const float scale : {1.2f, 1.5f, 2.5f}) {
+    ImagePyramid pyramid(img.cols, img.rows, 4, scale);
+    pyramid.buildLevels(img);
+    for (int i = 1; i < pyramid.numLevels(); ++i) {
+      EXPECT_EQ(pyramid.shuffleGatherPossible(i), scale < 2.0f) << "scale " << scale << " level " << i;
+      const cv::Mat expected = referenceDownsample(pyramid.level(i - 1), pyramid.level(i).size());
+      EXPECT_EQ(cv::norm(pyramid.level(i), expected, cv::NORM_INF), 0) << "scale " << scale << " level " << i;
+    }
+  }
+}
+
+TEST(FrontendKernels, BlurOfRectanglesEqualsTheWholeImageBlurInsideThem) {
+  // ORB blurs only around its keypoints (ImagePyramid::blurRect): small, odd-sized rectangles
+  // at the image edges and inside must get exactly the whole-image values, and nothing outside
+  // them may be written.
+  const cv::Mat img = testImage(643, 481, 13);
+  ImagePyramid whole(img.cols, img.rows, 8, 1.2f);
+  whole.build(img);
+  ImagePyramid parts(img.cols, img.rows, 8, 1.2f);
+  parts.buildLevels(img);
+  const cv::Rect rects[] = {{0, 0, 5, 3}, {0, 0, 16, 16}, {1, 2, 7, 9}, {30, 40, 17, 33}, {100, 7, 64, 16},
+                            {200, 200, 3, 40}, {600, 450, 43, 31}, {630, 10, 13, 20}, {2, 470, 30, 11}};
+  for (int level = 0; level < 8; ++level) {
+    const cv::Mat before = parts.blurred(level).clone();
+    cv::Mat written(before.size(), CV_8UC1, cv::Scalar(0));
+    for (const cv::Rect& r : rects) {
+      const cv::Rect clipped = r & cv::Rect(0, 0, before.cols, before.rows);
+      if (clipped.empty()) continue;
+      parts.blurRect(level, r.x, r.y, r.x + r.width, r.y + r.height);
+      written(clipped).setTo(1);
+      EXPECT_EQ(cv::norm(parts.blurred(level)(clipped), whole.blurred(level)(clipped), cv::NORM_INF), 0)
+          << "level " << level << " rect " << r;
+    }
+    const cv::Mat untouched = written == 0;
+    EXPECT_EQ(cv::norm(parts.blurred(level), before, cv::NORM_INF, untouched), 0) << "level " << level;
+    EXPECT_GT(cv::countNonZero(written), 0);
+  }
+}
+
 TEST(FrontendKernels, OrientationEqualsIntensityCentroidOverTheDisc) {
   const cv::Mat img = testImage(200, 150, 12);
   const OrbDescriber describer(static_cast<int>(img.step[0]));

@@ -112,6 +112,29 @@ TEST(PoseOptimizer, CovarianceIsTheInverseOfTheInlierHessian) {
 }
 
 // More observations of the same quality cannot make the pose less certain.
+TEST(PoseOptimizer, WithoutCovarianceGivesTheSamePoseAndInliers) {
+  const PoseProblem p = makePoseProblem(46, 200, 20, 0.1);
+  Vector6d delta;
+  delta << -0.01, 0.02, 0.01, 0.02, -0.01, 0.01;
+  const int n = static_cast<int>(p.points.size()), m = static_cast<int>(p.lines.size());
+  std::unique_ptr<bool[]> points_a(new bool[n]), lines_a(new bool[m]), points_b(new bool[n]), lines_b(new bool[m]);
+  PoseOptimizerOptions options;
+  const Eigen::Isometry3d start = applyLeftIncrement(delta, p.T_cam_world_true);
+  const PoseResult with = optimizePose(p.camera, start, p.points.data(), n, p.lines.data(), m, options,
+                                       points_a.get(), lines_a.get());
+  options.compute_covariance = false;
+  const PoseResult without = optimizePose(p.camera, start, p.points.data(), n, p.lines.data(), m, options,
+                                          points_b.get(), lines_b.get());
+  ASSERT_TRUE(with.covariance_valid);
+  EXPECT_FALSE(without.covariance_valid);
+  EXPECT_EQ(without.final_cost, 0.0);
+  EXPECT_TRUE(without.T_cam_world.matrix() == with.T_cam_world.matrix());  // bit for bit
+  EXPECT_EQ(without.iterations, with.iterations);
+  EXPECT_EQ(without.num_point_inliers, with.num_point_inliers);
+  for (int i = 0; i < n; ++i) EXPECT_EQ(points_a[i], points_b[i]);
+  for (int i = 0; i < m; ++i) EXPECT_EQ(lines_a[i], lines_b[i]);
+}
+
 TEST(PoseOptimizer, CovarianceShrinksWithMoreObservations) {
   const PoseProblem p = makePoseProblem(42, 400, 0, 0.0);
   PoseOptimizerOptions options;

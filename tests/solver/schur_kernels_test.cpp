@@ -124,5 +124,63 @@ TEST(SolverKernels, SchurBlockKernelsEqualEigenProducts) {
   }
 }
 
+TEST(SolverKernels, RankOneLineSampleBlocksEqualTheGeneralForms) {
+  // Line samples: with j = J_cam^T and c = w Omega, A^T M A = u (A^T j)^T (addRankOne) and
+  // V_a W_b^T = u_a (r_a^T H^-1 r_b) u_b^T (subtractScaledOuter[Lower]), against the 3x3 M forms.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const CameraIntrinsics camera{525.0, 523.0, 319.5, 239.5, 40.0};
+  for (int n = 0; n < 200; ++n) {
+    const Eigen::Matrix3d R = expSO3(Eigen::Vector3d(u(rng), u(rng), u(rng)));
+    Eigen::Vector3d P_cam[2], r[2];
+    Vector6d A_t_j[2], u_vec[2];
+    Matrix63d W[2];
+    PoseNormalAccumulator general, rank_one;
+    for (int k = 0; k < 2; ++k) {
+      P_cam[k] = Eigen::Vector3d(2.0 * u(rng), 1.5 * u(rng), 2.5 + 2.0 * u(rng));
+      const Eigen::Vector3d line = Eigen::Vector3d(u(rng), u(rng), 100 * u(rng));
+      double e = 0.0;
+      Eigen::RowVector3d J_cam;
+      lineResidualAt(camera, P_cam[k], line, &e, &J_cam);
+      const double c = 0.5 + 0.5 * u(rng);
+      const Eigen::Vector3d j = J_cam.transpose();
+      const Eigen::Matrix3d M = c * j * J_cam;
+      general.add(M, c * e * j, P_cam[k]);
+      A_t_j[k] << j, P_cam[k].cross(j);
+      u_vec[k] = c * A_t_j[k];
+      rank_one.addRankOne(u_vec[k], A_t_j[k], e * u_vec[k]);
+      r[k] = R.transpose() * j;
+      const Eigen::Matrix3d MR = M * R;
+      W[k].topRows<3>() = MR;
+      for (int col = 0; col < 3; ++col) W[k].block<3, 1>(3, col) = P_cam[k].cross(MR.col(col));
+      ASSERT_LT(relativeError(Matrix63d(u_vec[k] * r[k].transpose()), W[k]), kTolerance) << n;
+    }
+    Matrix6d H_general, H_rank_one;
+    Vector6d g_general, g_rank_one;
+    general.finish(&H_general, &g_general);
+    rank_one.finish(&H_rank_one, &g_rank_one);
+    ASSERT_LT(relativeError(H_rank_one, H_general), kTolerance) << n;
+    ASSERT_LT(relativeError(g_rank_one, g_general), kTolerance) << n;
+
+    const Eigen::Matrix3d H_inv = randomInformation(rng);
+    const double gamma = r[0].dot(H_inv * r[1]);
+    const Matrix6d expected = -(W[1] * H_inv) * W[0].transpose();  // S_10 -= V_1 W_0^T
+    Matrix6d S = Matrix6d::Zero();
+    subtractScaledOuter(gamma, u_vec[1].data(), u_vec[0].data(), S.data(), 6);
+    ASSERT_LT(relativeError(S, expected), kTolerance) << n;
+    const Matrix6d expected_diagonal = -(W[0] * H_inv) * W[0].transpose();
+    Matrix6d S_lower = Matrix6d::Zero();
+    subtractScaledOuterLower(r[0].dot(H_inv * r[0]), u_vec[0].data(), u_vec[0].data(), S_lower.data(), 6);
+    // Lower triangle as the Cholesky reads it (row pairs from (c & ~1) down may also hold entries
+    // just above the diagonal, written with the same values).
+    for (int col = 0; col < 6; ++col) {
+      for (int row = col; row < 6; ++row) {
+        ASSERT_NEAR(S_lower(row, col), expected_diagonal(row, col), kTolerance * std::max(1.0, expected_diagonal.norm()))
+            << n << " (" << row << ", " << col << ")";
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace plumb
