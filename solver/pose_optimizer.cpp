@@ -63,13 +63,14 @@ double robustCost(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_cam
   return cost;
 }
 
-// IRLS normal equations of the inliers at T_cam_world.
+// IRLS normal equations of the inliers at T_cam_world; with H_map, also the information blocks
+// scaled by each observation's map_share (summed, not inverted: the map-error term of the top).
 NormalEquations linearize(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_cam_world,
                           const PosePointObservation* points, int num_points, const PoseLineObservation* lines,
                           int num_lines, const Kernels& kernels, const bool* point_inliers,
-                          const bool* line_inliers) {
+                          const bool* line_inliers, Matrix6d* H_map = nullptr) {
   NormalEquations ne;
-  PoseNormalAccumulator accumulator;
+  PoseNormalAccumulator accumulator, map_accumulator;
   for (int i = 0; i < num_points; ++i) {
     if (!point_inliers[i]) continue;
     const PosePointObservation& obs = points[i];
@@ -97,6 +98,7 @@ NormalEquations linearize(const CameraIntrinsics& camera, const Eigen::Isometry3
       ne.cost += 0.5 * rho;
     }
     accumulator.add(M, q, P_cam);
+    if (H_map != nullptr && obs.map_share > 0) map_accumulator.add(obs.map_share * M, Eigen::Vector3d::Zero(), P_cam);
   }
   for (int i = 0; i < num_lines; ++i) {
     if (!line_inliers[i]) continue;
@@ -114,9 +116,14 @@ NormalEquations linearize(const CameraIntrinsics& camera, const Eigen::Isometry3
     A_t_j << j, P_cam.cross(j);
     const Vector6d u = (weight * obs.information) * A_t_j;
     accumulator.addRankOne(u, A_t_j, e * u);
+    if (H_map != nullptr && obs.map_share > 0) map_accumulator.addRankOne(obs.map_share * u, A_t_j, Vector6d::Zero());
     ne.cost += 0.5 * rho;
   }
   accumulator.finish(&ne.H, &ne.g);
+  if (H_map != nullptr) {
+    Vector6d unused;
+    map_accumulator.finish(H_map, &unused);
+  }
   return ne;
 }
 
@@ -208,13 +215,15 @@ PoseResult optimizePose(const CameraIntrinsics& camera, const Eigen::Isometry3d&
   }
 
   if (!options.compute_covariance) return result;
+  Matrix6d H_map;
   const NormalEquations ne = linearize(camera, result.T_cam_world, points, num_points, lines, num_lines,
-                                       kernels, point_inliers, line_inliers);
+                                       kernels, point_inliers, line_inliers, &H_map);
   result.final_cost = ne.cost;
   const Eigen::LLT<Matrix6d> llt(ne.H);
   if (llt.info() == Eigen::Success) {
     result.covariance = llt.solve(Matrix6d::Identity());
-    result.covariance_valid = result.covariance.allFinite();
+    result.map_covariance = result.covariance * H_map * result.covariance;
+    result.covariance_valid = result.covariance.allFinite() && result.map_covariance.allFinite();
   }
   return result;
 }

@@ -16,6 +16,13 @@
 // solver/se3.h. `covariance_valid` is false when H is not positive definite (too few inliers,
 // degenerate geometry).
 //
+// Map error: pose-only holds the landmarks exact, but a landmark's position carries the errors of
+// the measurements it was made from. With `map_share` s_i per observation (the landmark's error,
+// seen in this observation's residual, taken as s_i times this measurement's covariance: 1/n for
+// a landmark averaged from n measurements like this one), `map_covariance` = C (sum_inliers s_i
+// J_i^T (w_i Omega_i) J_i) C is the pose error the landmark errors cause (first order, landmarks
+// independent of each other). It does not change the estimate.
+//
 // No heap allocation: inputs are caller arrays, inlier flags are written into caller buffers.
 #include <cmath>
 
@@ -57,6 +64,7 @@ struct PosePointObservation {
   Eigen::Vector3d z = Eigen::Vector3d::Zero();  // [u, v, u_r]
   Eigen::Matrix3d information = Eigen::Matrix3d::Identity();
   bool has_depth = true;
+  double map_share = 0.0;  // landmark error / measurement covariance (see the top); 0 = exact
 };
 
 // A line-guidance sample: world point P that should project onto the normalised observed line.
@@ -64,6 +72,7 @@ struct PoseLineObservation {
   Eigen::Vector3d P_world = Eigen::Vector3d::Zero();
   Eigen::Vector3d line = Eigen::Vector3d(1.0, 0.0, 0.0);  // [a, b, c], a^2 + b^2 = 1
   double information = 1.0;
+  double map_share = 0.0;  // as for points
 };
 
 struct PoseResult {
@@ -75,6 +84,7 @@ struct PoseResult {
   double final_cost = 0.0;    // robust cost of the final inliers at the final pose
   Matrix6d covariance = Matrix6d::Zero();
   bool covariance_valid = false;
+  Matrix6d map_covariance = Matrix6d::Zero();  // valid with covariance_valid (see the top)
   // chi2 of the final inliers at the final pose (the last classification), for the a posteriori
   // variance factor (solver/variance_factor.h; redundancy: their error dof - 6).
   InlierChi2Sums inlier_chi2;

@@ -25,6 +25,7 @@ struct LocalMapPoint {
   Descriptor256 descriptor;
   float ref_distance_m = 1.f;
   int8_t ref_octave = 0;
+  uint8_t keyframe_observations = 1;  // keyframes observing it (its position averages them)
 };
 
 struct LocalMapLine {
@@ -34,6 +35,7 @@ struct LocalMapLine {
   Eigen::Vector3d start_world = Eigen::Vector3d::Zero();
   Eigen::Vector3d end_world = Eigen::Vector3d::Zero();
   Descriptor256 descriptor;
+  uint8_t keyframe_observations = 1;  // keyframes observing it
 };
 
 struct LocalMapKeyframe {

@@ -57,6 +57,7 @@ void LocalMapper::publishSnapshot(int kf_slot) {
       lp->descriptor = p.descriptor;
       lp->ref_distance_m = p.ref_distance_m;
       lp->ref_octave = p.ref_octave;
+      lp->keyframe_observations = uint8_t(std::clamp(p.observers.count(), 1, 255));
     }
     for (const auto& obs : kf.lines) {
       if (s_->line_stamp[obs.line_slot] == stamp_ || out.lines.full()) continue;
@@ -69,6 +70,7 @@ void LocalMapper::publishSnapshot(int kf_slot) {
       ll->start_world = l.start_world;
       ll->end_world = l.end_world;
       ll->descriptor = l.descriptor;
+      ll->keyframe_observations = uint8_t(std::clamp(l.observers.count(), 1, 255));
     }
   }
 }

@@ -99,6 +99,8 @@ class Tracker {
   // linearisation fewer). (A looser step tolerance there, 1e-4, moved head250's ATE by +14 %.)
   PoseResult optimizeAndPrune(const FrameFeatures& frame, const Eigen::Isometry3d& T_cam_world,
                               TrackResult* result, bool final_pose = true);
+  // 1 / (keyframes that measured the landmark at local_index of the snapshot; 1 when unknown).
+  double mapShare(int local_index, bool point) const;
   // The tracked pose's published covariances (TrackResult) from the final optimisation.
   // twist_per_s: the frame's velocity (timing model error, UncertaintyOptions).
   void publishCovariance(const PoseResult& pose, const Vector6d& twist_per_s, TrackResult* result) const;

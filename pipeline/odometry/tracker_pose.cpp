@@ -1,9 +1,23 @@
 // Tracker: pose-only optimisation over the current associations, and pruning of the outliers.
+#include <algorithm>
+
 #include "pipeline/odometry/tracker.h"
 #include "solver/noise_model.h"
 #include "solver/pose_covariance.h"
 
 namespace plumb {
+
+double Tracker::mapShare(int local_index, bool point) const {
+  // A landmark measured by n keyframes like this frame measures it: its error, after local BA
+  // averaged them, is about 1/n of one measurement's. A last-frame point, or a landmark the
+  // snapshot no longer lists, counts as measured once (the conservative side).
+  int n = 1;
+  if (local_index >= 0) {
+    if (point && local_index < int(local_map_->points.size())) n = local_map_->points[local_index].keyframe_observations;
+    if (!point && local_index < int(local_map_->lines.size())) n = local_map_->lines[local_index].keyframe_observations;
+  }
+  return 1.0 / double(std::max(n, 1));
+}
 
 PoseResult Tracker::optimizeAndPrune(const FrameFeatures& frame, const Eigen::Isometry3d& T_cam_world,
                                      TrackResult* result, bool final_pose) {
@@ -33,6 +47,7 @@ PoseResult Tracker::optimizeAndPrune(const FrameFeatures& frame, const Eigen::Is
       obs->information.setZero();
       obs->information.topLeftCorner<2, 2>() = monoPointInformation(noise, kp.octave);
     }
+    obs->map_share = mapShare(b_->points[k].local_index, true);
     (void)point_keypoint.push_back(uint16_t(k));
   }
   if (options_.tracker.use_lines) {
@@ -40,12 +55,14 @@ PoseResult Tracker::optimizeAndPrune(const FrameFeatures& frame, const Eigen::Is
       const LineAssociation& a = b_->lines[k];
       if (!a.valid) continue;
       const double information = lineSampleInformation(noise, frame.lines[k].octave);
+      const double map_share = mapShare(a.local_index, false);
       for (int s = 0; s < a.num_samples; ++s) {
         PoseLineObservation* obs = lines.emplace_back();
         if (obs == nullptr) break;
         obs->P_world = a.samples_world[s];
         obs->line = frame.lines[k].l;
         obs->information = information;
+        obs->map_share = map_share;
         (void)line_index.push_back(uint16_t(k));
       }
     }
@@ -100,10 +117,16 @@ void Tracker::publishCovariance(const PoseResult& pose, const Vector6d& twist_pe
                              rollingShutterCovariance(options_.uncertainty, camera_.rolling_shutter_readout_s,
                                                       options_.uncertainty.rolling_shutter_frame_share);
   // The map is held exact by pose-only optimisation: covariance_local is the frame relative to
-  // it, i.e. to the reference keyframe, whose world covariance it chains with.
+  // it (what two consecutive frames do not share: the velocity's). Relative to the reference
+  // keyframe, whose world covariance it chains with, the frame also carries the landmarks' own
+  // position errors (PoseResult::map_covariance), which consecutive frames share.
   if (!local_map_->reference_world_covariance_valid) return;
+  Matrix6d relative_to_reference = result->covariance_local;
+  if (options_.uncertainty.tracked_map_error) {
+    relative_to_reference += inflateTrackedCovariance(options_.uncertainty, pose.map_covariance, variance_factor);
+  }
   result->covariance = chainPoseCovariance(local_map_->T_world_reference.inverse(), pose.T_cam_world,
-                                           local_map_->reference_world_covariance, result->covariance_local);
+                                           local_map_->reference_world_covariance, relative_to_reference);
   result->covariance_valid = true;
 }
 

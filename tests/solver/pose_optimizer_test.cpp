@@ -147,6 +147,34 @@ TEST(PoseOptimizer, CovarianceShrinksWithMoreObservations) {
   EXPECT_LT(many.covariance.trace(), few.covariance.trace());
 }
 
+// The map-error term C (sum s_i H_i) C: every landmark as uncertain as its measurement (s = 1)
+// gives C itself; exact landmarks (s = 0) give nothing; the estimate and C never depend on s.
+TEST(PoseOptimizer, MapCovarianceWeighsEachObservationsInformationByItsShare) {
+  PoseProblem p = makePoseProblem(46, 200, 20, 0.0);
+  const PoseOptimizerOptions options;
+  std::unique_ptr<bool[]> point_inliers(new bool[p.points.size()]);
+  std::unique_ptr<bool[]> line_inliers(new bool[p.lines.size()]);
+  auto solve = [&](double point_share, double line_share) {
+    for (PosePointObservation& o : p.points) o.map_share = point_share;
+    for (PoseLineObservation& o : p.lines) o.map_share = line_share;
+    return optimizePose(p.camera, p.T_cam_world_true, p.points.data(), static_cast<int>(p.points.size()),
+                        p.lines.data(), static_cast<int>(p.lines.size()), options, point_inliers.get(),
+                        line_inliers.get());
+  };
+  const PoseResult exact = solve(0.0, 0.0), once = solve(1.0, 1.0), half = solve(0.5, 0.5);
+  const PoseResult points_only = solve(1.0, 0.0);
+  ASSERT_TRUE(exact.covariance_valid && once.covariance_valid && half.covariance_valid);
+  ASSERT_FALSE(p.lines.empty());
+  EXPECT_EQ(exact.map_covariance.norm(), 0.0);
+  EXPECT_LT((once.map_covariance - once.covariance).norm(), 1e-9 * once.covariance.norm());
+  EXPECT_LT((2.0 * half.map_covariance - once.map_covariance).norm(), 1e-9 * once.covariance.norm());
+  // Lines carry part of the information: without their share the term is smaller, not zero.
+  EXPECT_GT(points_only.map_covariance.trace(), 0.0);
+  EXPECT_LT(points_only.map_covariance.trace(), once.map_covariance.trace());
+  EXPECT_TRUE(exact.T_cam_world.isApprox(once.T_cam_world, 0.0));
+  EXPECT_TRUE(exact.covariance.isApprox(once.covariance, 0.0));
+}
+
 TEST(PoseOptimizer, TooFewObservationsGiveNoCovarianceAndNoNaN) {
   const PoseProblem p = makePoseProblem(43, 1, 0, 0.0);
   bool inlier = false;
