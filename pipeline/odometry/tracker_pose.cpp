@@ -10,7 +10,9 @@ namespace plumb {
 double Tracker::mapShare(int local_index, bool point) const {
   // A landmark measured by n keyframes like this frame measures it: its error, after local BA
   // averaged them, is about 1/n of one measurement's. A last-frame point, or a landmark the
-  // snapshot no longer lists, counts as measured once (the conservative side).
+  // snapshot no longer lists, counts as measured once (the conservative side). 0 while the
+  // option that publishes the term is off: the optimiser then skips its accumulation.
+  if (!options_.uncertainty.tracked_map_error) return 0.0;
   int n = 1;
   if (local_index >= 0) {
     if (point && local_index < int(local_map_->points.size())) n = local_map_->points[local_index].keyframe_observations;
