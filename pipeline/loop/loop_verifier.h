@@ -46,8 +46,10 @@ struct LoopVerifierOptions {
   // A point whose two nearest candidate descriptors fail the ratio test enters RANSAC with both
   // (geometry decides) instead of being dropped. Repeated furniture makes the ratio test drop the
   // true matches of a revisit: office_loop with Kinect-like noise, 0.25 m from the first view,
-  // kept 39 matches of its points (docs/LOOP.md "Recall").
-  bool ambiguous_pairs = true;
+  // kept 39 matches of its points (docs/LOOP.md "Recall"). Off by default: with the calibrated
+  // loop covariance it let 4 wrong loops through on synth:loop seeds 1-2 (one beyond 5 cm / 2 deg)
+  // and recalled no more revisits over the study (docs/LOOP.md "Study", the merged tree).
+  bool ambiguous_pairs = false;
   int min_matches = 40;           // query points matched
   RigidRansacOptions ransac;
   int min_inliers = 35;           // RANSAC inliers

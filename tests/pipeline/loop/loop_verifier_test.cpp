@@ -221,7 +221,9 @@ TEST(LoopVerifier, RepeatedFurnitureIsMatchedByGeometryWhereTheRatioTestDropsIt)
   EXPECT_EQ(dropped.rejection, loop::LoopRejection::kFewMatches);
   EXPECT_LE(dropped.matches, unique);
 
-  auto verifier = makeVerifier();
+  loop::LoopVerifierOptions both_hypotheses;
+  both_hypotheses.ambiguous_pairs = true;  // off by default (loop_verifier.h)
+  loop::LoopVerifier verifier(intrinsicsOf(syntheticCamera()), NoiseModelOptions{}, both_hypotheses);
   const loop::LoopMeasurement m = verifier.verify(*b, *repeated);
   ASSERT_TRUE(m.accepted()) << loop::toString(m.rejection) << " matches " << m.matches;
   const Eigen::Isometry3d truth = Ta.inverse() * Tb;
