@@ -18,7 +18,7 @@ cd "$(dirname "$0")/.."
 JOBS=${JOBS:-$(nproc 2>/dev/null || echo 2)}
 PRESET=${PRESET:-asan}
 BUILD_DIR=build-${PRESET}
-ALL_AREAS=(platform runtime solver pipeline drivers api tools system)
+ALL_AREAS=(platform runtime solver pipeline drivers api tools viewer system)
 if [ "$#" -gt 0 ]; then AREAS=("$@"); else AREAS=("${ALL_AREAS[@]}"); fi
 
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0}
