@@ -82,15 +82,25 @@ void FastDetector::scan(int threshold, int x0, int y0, int x1, int y1) {
     if (num_raw_ < capacity_) raw_[num_raw_++] = FastCorner{int16_t(x), int16_t(y), uint8_t(std::min(score, 255))};
     else ++dropped_;
   };
-  // Max over the 16 cyclic arcs of 9 of the minimum of `diff` over the arc, by doubling:
-  // min over 2, 4, 8 consecutive, then the 9th.
+  // Max over the 16 cyclic arcs of 9 of the minimum of `diff` over the arc. With the circle
+  // unrolled to e[0..23] (e[i] = diff[i % 16]) and cut into blocks [0..8], [9..17], [18..23], an
+  // arc starting at k lies in one block (k = 0, 9) or is a suffix of one block and a prefix of
+  // the next, so suffix and prefix minima give every arc: 42 minimums instead of 64 by doubling.
   auto arcScore = [](const cv::v_uint8x16* diff, cv::v_uint8x16 score) {
-    cv::v_uint8x16 m2[16], m4[16];
-    for (int k = 0; k < 16; ++k) m2[k] = cv::v_min(diff[k], diff[(k + 1) & 15]);
-    for (int k = 0; k < 16; ++k) m4[k] = cv::v_min(m2[k], m2[(k + 2) & 15]);
-    for (int k = 0; k < 16; ++k) {
-      score = cv::v_max(score, cv::v_min(cv::v_min(m4[k], m4[(k + 4) & 15]), diff[(k + 8) & 15]));
-    }
+    auto e = [diff](int i) { return diff[i & 15]; };
+    cv::v_uint8x16 suffix_a[9], prefix_b[8], suffix_b[8], prefix_c[6];
+    suffix_a[8] = e(8);  // suffix_a[k] = min e[k..8]
+    for (int k = 7; k >= 0; --k) suffix_a[k] = cv::v_min(e(k), suffix_a[k + 1]);
+    prefix_b[0] = e(9);  // prefix_b[j] = min e[9..9 + j]
+    for (int j = 1; j < 8; ++j) prefix_b[j] = cv::v_min(prefix_b[j - 1], e(9 + j));
+    suffix_b[7] = e(17);  // suffix_b[j] = min e[10 + j..17]
+    for (int j = 6; j >= 0; --j) suffix_b[j] = cv::v_min(e(10 + j), suffix_b[j + 1]);
+    prefix_c[0] = e(18);  // prefix_c[j] = min e[18..18 + j]
+    for (int j = 1; j < 6; ++j) prefix_c[j] = cv::v_min(prefix_c[j - 1], e(18 + j));
+    score = cv::v_max(score, suffix_a[0]);  // the arc 0..8
+    for (int k = 1; k <= 8; ++k) score = cv::v_max(score, cv::v_min(suffix_a[k], prefix_b[k - 1]));
+    score = cv::v_max(score, cv::v_min(e(9), suffix_b[0]));  // the arc 9..17
+    for (int k = 10; k <= 15; ++k) score = cv::v_max(score, cv::v_min(suffix_b[k - 10], prefix_c[k - 10]));
     return score;
   };
   const int block_end = x_end - x0 >= 16 ? x_end : x0;  // rows narrower than a block: scalar only
@@ -114,8 +124,17 @@ void FastDetector::scan(int threshold, int x0, int y0, int x1, int y1) {
       const cv::v_uint8x16 bright_ns = (n - c_hi) | (s - c_hi), dark_ns = (c_lo - n) | (c_lo - s);
       if (!cv::v_check_any((bright_ns | dark_ns) != zero)) continue;
       const cv::v_uint8x16 e = cv::v_load(row + bx + circle[4]), w = cv::v_load(row + bx + circle[12]);
-      const cv::v_int8x16 compass_bright = cv::v_reinterpret_as_s8(cv::v_min(bright_ns, (e - c_hi) | (w - c_hi)) != zero);
-      const cv::v_int8x16 compass_dark = cv::v_reinterpret_as_s8(cv::v_min(dark_ns, (c_lo - e) | (c_lo - w)) != zero);
+      const cv::v_uint8x16 bright_4 = cv::v_min(bright_ns, (e - c_hi) | (w - c_hi));
+      const cv::v_uint8x16 dark_4 = cv::v_min(dark_ns, (c_lo - e) | (c_lo - w));
+      if (!cv::v_check_any((bright_4 | dark_4) != zero)) continue;
+      // The same for the other four even pixels: an arc of 9 covers 4 consecutive even pixels,
+      // one of each pair (0, 8), (2, 10), (4, 12), (6, 14).
+      const cv::v_uint8x16 ne = cv::v_load(row + bx + circle[2]), sw = cv::v_load(row + bx + circle[10]);
+      const cv::v_uint8x16 se = cv::v_load(row + bx + circle[6]), nw = cv::v_load(row + bx + circle[14]);
+      const cv::v_int8x16 compass_bright = cv::v_reinterpret_as_s8(
+          cv::v_min(bright_4, cv::v_min((ne - c_hi) | (sw - c_hi), (se - c_hi) | (nw - c_hi))) != zero);
+      const cv::v_int8x16 compass_dark = cv::v_reinterpret_as_s8(
+          cv::v_min(dark_4, cv::v_min((c_lo - ne) | (c_lo - sw), (c_lo - se) | (c_lo - nw))) != zero);
       if (!cv::v_check_any(compass_bright | compass_dark)) continue;
       const cv::v_int8x16 hi = flip(c_hi), lo = flip(c_lo);
       // Second filter, the full count: an arc of 9 needs >= 9 of the 16 pixels on one side. It
