@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <cstring>
 
 #include <opencv2/core/hal/intrin.hpp>
 
@@ -17,6 +16,20 @@ constexpr uint8_t kFree = 1, kUsed = 0;
 // array has one byte before pixel 0 and three after the last pixel.
 constexpr int kStateFront = 1, kStateBack = 3;
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "freeBits reads states as a little-endian word");
+
+// The states of 4 pixels from the 4-bit mask of which are above the threshold (bit i: pixel i).
+struct StateBytes {
+  uint8_t state[4];
+};
+constexpr StateBytes stateBytes(int mask) {
+  StateBytes b{};
+  for (int i = 0; i < 4; ++i) b.state[i] = (mask >> i) & 1 ? kFree : kUsed;
+  return b;
+}
+constexpr StateBytes kStateBytes[16] = {stateBytes(0),  stateBytes(1),  stateBytes(2),  stateBytes(3),
+                                        stateBytes(4),  stateBytes(5),  stateBytes(6),  stateBytes(7),
+                                        stateBytes(8),  stateBytes(9),  stateBytes(10), stateBytes(11),
+                                        stateBytes(12), stateBytes(13), stateBytes(14), stateBytes(15)};
 
 // Four bytes widened to int32 lanes. OpenCV 4.6's SSE v_load_expand_q reads them through an
 // int*, which is undefined behaviour (UBSan: misaligned load) when the address is not a multiple
@@ -89,9 +102,7 @@ int LineSegmentDetector::detect(const cv::Mat& image, float min_length, Detected
       cv::v_store(mag + x, m);
       cv::v_store(ux + x, gx * inv);
       cv::v_store(uy + x, gy * inv);
-      uint32_t above[4];
-      cv::v_store(above, cv::v_reinterpret_as_u32(m > v_threshold));
-      for (int i = 0; i < 4; ++i) st[x + i] = above[i] ? kFree : kUsed;
+      std::memcpy(st + x, &kStateBytes[cv::v_signmask(m > v_threshold)], 4);
       v_max = cv::v_max(v_max, m);
     }
     for (; x < w - 1; ++x) {
