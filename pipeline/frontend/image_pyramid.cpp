@@ -49,6 +49,102 @@ bool cpuHasShuffle() {
 }  // namespace
 #endif
 
+#if PLUMB_PYRAMID_SHUFFLE && defined(__x86_64__)
+namespace {
+
+// The blur of blur() on rows [y0, y1), columns [x0, x1) with SSSE3's pmaddubsw (unsigned bytes
+// times signed bytes, adjacent products summed into 16 bits): the two rows (or columns) that
+// share a weight are interleaved and multiplied by (k, k), the centre by (k3, 0). Every pair sum
+// is <= 255 * 2 * 127 (no saturation; the weights are < 128) and their total <= 255 * 256 wraps
+// nowhere in unsigned 16 bits, so the integers are those of the portable path. The vertical
+// result, (sum + 128) >> 8 <= 255, is kept in a byte row, so the horizontal pass multiplies bytes
+// too: 16 pixels per step in both passes instead of 8 in the horizontal one.
+struct ByteWeights {
+  __m128i pair[3], centre, round;
+  explicit ByteWeights(const std::array<int, 7>& k)
+      : pair{_mm_set1_epi16(int16_t(k[0] | k[0] << 8)), _mm_set1_epi16(int16_t(k[1] | k[1] << 8)),
+             _mm_set1_epi16(int16_t(k[2] | k[2] << 8))},
+        centre(_mm_set1_epi16(int16_t(k[3]))), round(_mm_set1_epi16(128)) {}
+};
+
+#define PLUMB_BYTE_BLUR_INLINE PLUMB_PYRAMID_SHUFFLE_TARGET inline __attribute__((always_inline))
+
+// 16 outputs (wide) or 8 (in the low half) from the 7 source rows, or shifted columns, at
+// p[0], p[step], ..., p[6 * step]; stored at d.
+template <bool kWide>
+PLUMB_BYTE_BLUR_INLINE void blurBytes(const uint8_t* const* rows, std::ptrdiff_t offset, const ByteWeights& w, uint8_t* d) {
+  const __m128i zero = _mm_setzero_si128();
+  __m128i v[7];
+  for (int i = 0; i < 7; ++i) {
+    v[i] = kWide ? _mm_loadu_si128(reinterpret_cast<const __m128i*>(rows[i] + offset))
+                 : _mm_loadl_epi64(reinterpret_cast<const __m128i*>(rows[i] + offset));
+  }
+  __m128i lo = _mm_maddubs_epi16(_mm_unpacklo_epi8(v[3], zero), w.centre);
+  for (int i = 0; i < 3; ++i) lo = _mm_add_epi16(lo, _mm_maddubs_epi16(_mm_unpacklo_epi8(v[i], v[6 - i]), w.pair[i]));
+  lo = _mm_srli_epi16(_mm_add_epi16(lo, w.round), 8);
+  if (kWide) {
+    __m128i hi = _mm_maddubs_epi16(_mm_unpackhi_epi8(v[3], zero), w.centre);
+    for (int i = 0; i < 3; ++i) hi = _mm_add_epi16(hi, _mm_maddubs_epi16(_mm_unpackhi_epi8(v[i], v[6 - i]), w.pair[i]));
+    hi = _mm_srli_epi16(_mm_add_epi16(hi, w.round), 8);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(d), _mm_packus_epi16(lo, hi));
+  } else {
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(d), _mm_packus_epi16(lo, lo));
+  }
+}
+
+// Blurs [begin, end) from `rows` (offset by the column) into d: blocks of 16, the last one moved
+// back to end at `end` (recomputing a few outputs with the same values), or one or two blocks of
+// 8 when the range is 8..15 wide; returns the first column left for a scalar tail.
+PLUMB_BYTE_BLUR_INLINE int blurBlocks(const uint8_t* const* rows, int begin, int end, const ByteWeights& w, uint8_t* d) {
+  if (end - begin >= 16) {
+    for (int x = begin; x < end;) {
+      const int bx = std::min(x, end - 16);
+      blurBytes<true>(rows, bx, w, d + bx);
+      x = bx + 16;
+    }
+    return end;
+  }
+  if (end - begin >= 8) {
+    blurBytes<false>(rows, begin, w, d + begin);
+    blurBytes<false>(rows, end - 8, w, d + end - 8);
+    return end;
+  }
+  return begin;
+}
+
+PLUMB_PYRAMID_SHUFFLE_TARGET void blurByteMultiplyAdd(const cv::Mat& src, cv::Mat& dst, int x0, int y0, int x1,
+                                                      int y1, const std::array<int, 7>& kernel, uint8_t* t) {
+  // t: the byte row, valid on [-3, w + 3) after the edge mirroring below.
+  const int w = src.cols, h = src.rows;
+  auto reflect = [](int i, int n) { return i < 0 ? -i : (i >= n ? 2 * n - 2 - i : i); };  // REFLECT_101
+  const ByteWeights weights(kernel);
+  const int vx0 = std::max(x0 - 3, 0), vx1 = std::min(x1 + 3, w);
+  const uint8_t* columns[7];  // the horizontal pass: t shifted by -3 .. 3
+  for (int i = 0; i < 7; ++i) columns[i] = t + i - 3;
+  for (int y = y0; y < y1; ++y) {
+    const uint8_t* r[7];
+    for (int i = 0; i < 7; ++i) r[i] = src.ptr<uint8_t>(reflect(y + i - 3, h));
+    for (int x = blurBlocks(r, vx0, vx1, weights, t); x < vx1; ++x) {
+      int acc = 0;
+      for (int i = 0; i < 7; ++i) acc += kernel[i] * r[i][x];
+      t[x] = static_cast<uint8_t>((acc + 128) >> 8);
+    }
+    for (int i = 1; i <= 3; ++i) {  // the horizontal pass reads t[x0 - 3 .. x1 + 2]
+      if (x0 < 3) t[-i] = t[reflect(-i, w)];
+      if (x1 + 3 > w) t[w - 1 + i] = t[reflect(w - 1 + i, w)];
+    }
+    uint8_t* d = dst.ptr<uint8_t>(y);
+    for (int x = blurBlocks(columns, x0, x1, weights, d); x < x1; ++x) {
+      int acc = 0;
+      for (int i = 0; i < 7; ++i) acc += kernel[i] * t[x + i - 3];
+      d[x] = static_cast<uint8_t>((acc + 128) >> 8);
+    }
+  }
+}
+
+}  // namespace
+#endif
+
 ImagePyramid::ImagePyramid(int width, int height, int num_levels, float scale_factor)
     : num_levels_(num_levels < 1 ? 1 : (num_levels > kPyramidLevels ? kPyramidLevels : num_levels)) {
   std::array<cv::Size, kPyramidLevels> sizes;
@@ -60,6 +156,7 @@ ImagePyramid::ImagePyramid(int width, int height, int num_levels, float scale_fa
     total_rows += sizes[i].height;
   }
   row_filtered_.create(1, width + 6, CV_16UC1);  // one padded row
+  row_filtered_bytes_.create(1, width + 6, CV_8UC1);
   high_row_.create(1, width + 8, CV_16SC1);  // + padding: see downsample()
   low_row_.create(1, width + 8, CV_16SC1);
   high_row_.setTo(0);
@@ -95,6 +192,10 @@ ImagePyramid::ImagePyramid(int width, int height, int num_levels, float scale_fa
   kernel_[3] += 256 - sum;  // exact unit gain
   // blur() relies on the symmetry (rounding symmetric weights keeps them symmetric).
   CV_Assert(kernel_[0] == kernel_[6] && kernel_[1] == kernel_[5] && kernel_[2] == kernel_[4]);
+  // The byte path where the CPU has it; its signed-byte weights need every tap < 128 (sigma 2:
+  // 18, 34, 49, 54, 49, 34, 18).
+  CV_Assert(*std::max_element(kernel_.begin(), kernel_.end()) < 128);
+  setBlurPath(BlurPath::kByteMultiplyAdd);
   buffer_.create(total_rows, width, CV_8UC1);
   blurred_buffer_.create(total_rows, width, CV_8UC1);
   buffer_.setTo(0);
@@ -245,7 +346,28 @@ void ImagePyramid::downsample(int level) {
   }
 }
 
+bool ImagePyramid::setBlurPath(BlurPath path) {
+  if (path == BlurPath::kByteMultiplyAdd) {
+#if PLUMB_PYRAMID_SHUFFLE && defined(__x86_64__)
+    if (!cpuHasShuffle()) return false;  // pmaddubsw is SSSE3, like pshufb
+#else
+    return false;
+#endif
+  }
+  blur_path_ = path;
+  return true;
+}
+
 void ImagePyramid::blur(const cv::Mat& src, cv::Mat& dst, int x0, int y0, int x1, int y1) {
+#if PLUMB_PYRAMID_SHUFFLE && defined(__x86_64__)
+  if (blur_path_ == BlurPath::kByteMultiplyAdd) {
+    const int w = src.cols, h = src.rows;
+    x0 = std::max(x0, 0), y0 = std::max(y0, 0), x1 = std::min(x1, w), y1 = std::min(y1, h);
+    if (x0 >= x1 || y0 >= y1) return;
+    blurByteMultiplyAdd(src, dst, x0, y0, x1, y1, kernel_, row_filtered_bytes_.ptr<uint8_t>(0) + 3);
+    return;
+  }
+#endif
   // Separable, vertical pass first, 8.8 fixed point: the vertical sum (<= 255 * 256) is rounded
   // back to 8 bits of range so the horizontal pass also fits 16-bit lanes (the lost fraction is far
   // below what the binary tests can see). One padded 16-bit row buffer, reflected borders.

@@ -38,6 +38,13 @@ class ImagePyramid {
   int stride() const { return static_cast<int>(buffer_.step[0]); }  // bytes per row, every level
   // Whether downsample() can gather level i's bilinear pairs by byte shuffles (tests).
   bool shuffleGatherPossible(int level) const { return shuffle_ok_[level]; }
+  // The blur's two implementations, the same integers: byte multiply-adds (SSSE3 pmaddubsw,
+  // x86-64 CPUs that have it, chosen at construction) or the portable 16-bit form (OpenCV's
+  // universal intrinsics: SSE2, NEON). setBlurPath returns false, changing nothing, for a path
+  // this CPU or build does not have (tests run both).
+  enum class BlurPath { kPortable, kByteMultiplyAdd };
+  BlurPath blurPath() const { return blur_path_; }
+  bool setBlurPath(BlurPath path);
 
  private:
   int num_levels_;
@@ -72,6 +79,8 @@ class ImagePyramid {
 
   cv::Mat buffer_, blurred_buffer_;
   cv::Mat row_filtered_;            // CV_16UC1, one row + 3 px padding each side: the blur's vertical pass
+  cv::Mat row_filtered_bytes_;      // CV_8UC1, the same for the byte path (the vertical result fits a byte)
+  BlurPath blur_path_ = BlurPath::kPortable;
   std::array<int, 7> kernel_{};     // 7-tap Gaussian, sigma 2, fixed point (sum 256)
   std::array<cv::Mat, kPyramidLevels> levels_, blurred_levels_;
 };

@@ -121,7 +121,40 @@ TEST(FrontendKernels, PyramidEqualsExactBilinearWithAndWithoutShuffleGather) {
   }
 }
 
-TEST(FrontendKernels, BlurOfRectanglesEqualsTheWholeImageBlurInsideThem) {
+TEST(FrontendKernels, BlurPathsEqualTheFixedPointReference) {
+  // The byte multiply-add blur (SSSE3, where the CPU has it) and the portable 16-bit one give the
+  // reference's integers on every level, including the 8..15 and < 8 px wide levels and edges.
+  const cv::Mat img = testImage(643, 481, 15);
+  ImagePyramid portable(img.cols, img.rows, 8, 1.2f), bytes(img.cols, img.rows, 8, 1.2f);
+  ASSERT_TRUE(portable.setBlurPath(ImagePyramid::BlurPath::kPortable));
+  EXPECT_EQ(portable.blurPath(), ImagePyramid::BlurPath::kPortable);
+  if (!bytes.setBlurPath(ImagePyramid::BlurPath::kByteMultiplyAdd)) {
+    GTEST_SKIP() << "no SSSE3 (or not x86-64): only the portable blur exists here, tested above";
+  }
+  portable.build(img);
+  bytes.build(img);
+  for (int i = 0; i < 8; ++i) {
+    const cv::Mat expected = referenceBlur(portable.level(i));
+    EXPECT_EQ(cv::norm(portable.blurred(i), expected, cv::NORM_INF), 0) << "portable, level " << i;
+    EXPECT_EQ(cv::norm(bytes.blurred(i), expected, cv::NORM_INF), 0) << "bytes, level " << i;
+  }
+  // Narrow images take the 8-wide blocks (8..15 px) and the scalar columns (< 8 px).
+  for (const int width : {5, 8, 11, 16, 21}) {
+    const cv::Mat narrow = testImage(width, 40, 16 + width);
+    ImagePyramid a(width, 40, 1, 1.2f), b(width, 40, 1, 1.2f);
+    ASSERT_TRUE(a.setBlurPath(ImagePyramid::BlurPath::kPortable));
+    ASSERT_TRUE(b.setBlurPath(ImagePyramid::BlurPath::kByteMultiplyAdd));
+    a.build(narrow);
+    b.build(narrow);
+    const cv::Mat expected = referenceBlur(narrow);
+    EXPECT_EQ(cv::norm(a.blurred(0), expected, cv::NORM_INF), 0) << "portable, width " << width;
+    EXPECT_EQ(cv::norm(b.blurred(0), expected, cv::NORM_INF), 0) << "bytes, width " << width;
+  }
+}
+
+class BlurOfRectangles : public ::testing::TestWithParam<ImagePyramid::BlurPath> {};
+
+TEST_P(BlurOfRectangles, EqualTheWholeImageBlurInsideThem) {
   // ORB blurs only around its keypoints (ImagePyramid::blurRect): small, odd-sized rectangles
   // at the image edges and inside must get exactly the whole-image values, and nothing outside
   // them may be written.
@@ -129,6 +162,7 @@ TEST(FrontendKernels, BlurOfRectanglesEqualsTheWholeImageBlurInsideThem) {
   ImagePyramid whole(img.cols, img.rows, 8, 1.2f);
   whole.build(img);
   ImagePyramid parts(img.cols, img.rows, 8, 1.2f);
+  if (!parts.setBlurPath(GetParam())) GTEST_SKIP() << "this blur path does not exist on this CPU";
   parts.buildLevels(img);
   const cv::Rect rects[] = {{0, 0, 5, 3}, {0, 0, 16, 16}, {1, 2, 7, 9}, {30, 40, 17, 33}, {100, 7, 64, 16},
                             {200, 200, 3, 40}, {600, 450, 43, 31}, {630, 10, 13, 20}, {2, 470, 30, 11}};
@@ -148,6 +182,12 @@ TEST(FrontendKernels, BlurOfRectanglesEqualsTheWholeImageBlurInsideThem) {
     EXPECT_GT(cv::countNonZero(written), 0);
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(FrontendKernels, BlurOfRectangles,
+                         ::testing::Values(ImagePyramid::BlurPath::kPortable, ImagePyramid::BlurPath::kByteMultiplyAdd),
+                         [](const ::testing::TestParamInfo<ImagePyramid::BlurPath>& info) {
+                           return info.param == ImagePyramid::BlurPath::kPortable ? "Portable" : "ByteMultiplyAdd";
+                         });
 
 TEST(FrontendKernels, OrientationEqualsIntensityCentroidOverTheDisc) {
   const cv::Mat img = testImage(200, 150, 12);
