@@ -41,8 +41,7 @@ FeatureExtractor::FeatureExtractor(const PinholeCamera& camera, const ExtractorO
     : camera_(camera), options_(options),
       orb_(new OrbExtractor(camera, options)),
       lines_(new LineExtractor(camera, options)),
-      depth_(new DepthSampler(camera, options)),
-      grey_(camera.height, camera.width, CV_8UC1) {
+      depth_(new DepthSampler(camera, options)) {
   undistortedBounds(camera_, &grid_u0_, &grid_v0_, &grid_u1_, &grid_v1_);
 }
 
@@ -57,15 +56,20 @@ bool FeatureExtractor::extract(const cv::Mat& bgr, const cv::Mat& depth_raw, dou
       (bgr.type() != CV_8UC3 && bgr.type() != CV_8UC1)) {
     return false;
   }
+  // Grey straight into the pyramid's level 0 (same size and type: cvtColor and copyTo write in
+  // place), so the pyramid does not copy it again.
+  cv::Mat& grey = orb_->greyInput();
+  const uint8_t* const grey_data = grey.data;
   if (bgr.type() == CV_8UC3) {
-    cv::cvtColor(bgr, grey_, cv::COLOR_BGR2GRAY);
+    cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
   } else {
-    bgr.copyTo(grey_);
+    bgr.copyTo(grey);
   }
+  CV_Assert(grey.data == grey_data);  // written in place, not reallocated
 
   const auto t_orb = StageClock::now();
   const double cpu_orb = threadCpuMs();
-  orb_->extract(grey_, out);
+  orb_->extract(grey, out);
   timings_.orb_ms = msSince(t_orb);
   timings_.orb_cpu_ms = threadCpuMs() - cpu_orb;
   timings_.pyramid_ms = orb_->lastPyramidMs();

@@ -47,7 +47,6 @@ class FeatureExtractor {
   std::unique_ptr<OrbExtractor> orb_;
   std::unique_ptr<LineExtractor> lines_;
   std::unique_ptr<DepthSampler> depth_;
-  cv::Mat grey_;  // level-0 grey image, allocated once
   float grid_u0_ = 0, grid_v0_ = 0, grid_u1_ = 0, grid_v1_ = 0;  // undistorted image bounds
   ExtractorTimings timings_;
 };

@@ -216,7 +216,7 @@ void ImagePyramid::build(const cv::Mat& grey) {
 }
 
 void ImagePyramid::buildLevels(const cv::Mat& grey) {
-  grey.copyTo(levels_[0]);  // levels_[0] has the right size: copyTo writes in place
+  if (grey.data != levels_[0].data) grey.copyTo(levels_[0]);  // the right size: copyTo writes in place
   for (int i = 1; i < num_levels_; ++i) {
     // Resize from the previous level (as ORB-SLAM does): cheap, and the 1.2 step keeps
     // bilinear aliasing small.

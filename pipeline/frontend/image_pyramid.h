@@ -22,7 +22,8 @@ class ImagePyramid {
  public:
   ImagePyramid(int width, int height, int num_levels, float scale_factor);
 
-  // grey: CV_8UC1 of the level-0 size. Fills every level and the blurred levels.
+  // grey: CV_8UC1 of the level-0 size. Fills every level and the blurred levels. `grey` may be
+  // levelZero() itself (written by the caller in place: no copy).
   void build(const cv::Mat& grey);
   // Fills the levels only; blurRect() then blurs just the parts a caller reads (ORB blurs the
   // neighbourhoods of the keypoints it describes: ~half of the pixels on fr1/rpy). A blurred
@@ -34,6 +35,9 @@ class ImagePyramid {
   int numLevels() const { return num_levels_; }
   float scale(int level) const { return scales_[level]; }  // scale_factor^level
   const cv::Mat& level(int i) const { return levels_[i]; }
+  // Level 0 for a caller to write the next grey image into (e.g. by cv::cvtColor, which keeps
+  // the buffer as its size and type match) before build(levelZero()).
+  cv::Mat& levelZero() { return levels_[0]; }
   const cv::Mat& blurred(int i) const { return blurred_levels_[i]; }
   int stride() const { return static_cast<int>(buffer_.step[0]); }  // bytes per row, every level
   // Whether downsample() can gather level i's bilinear pairs by byte shuffles (tests).

@@ -26,8 +26,11 @@ class OrbExtractor {
  public:
   OrbExtractor(const PinholeCamera& camera, const ExtractorOptions& options);
 
-  // grey: CV_8UC1 camera-sized. Builds the pyramid, appends keypoints + descriptors to `out`.
+  // grey: CV_8UC1 camera-sized (or greyInput() written in place). Builds the pyramid, appends
+  // keypoints + descriptors to `out`.
   void extract(const cv::Mat& grey, FrameFeatures& out);
+  // The pyramid's level 0: a caller that converts its colour image straight into it saves a copy.
+  cv::Mat& greyInput() { return pyramid_.levelZero(); }
 
   const ImagePyramid& pyramid() const { return pyramid_; }
   double lastPyramidMs() const { return pyramid_ms_; }
