@@ -101,16 +101,15 @@ void OrbDescriber::describe(const uint8_t* p, float angle_deg, Descriptor256& ou
   if (bin < 0) bin += kAngleBins;
   const int* first = first_offsets_[bin].data();
   const int* second = second_offsets_[bin].data();
-  // 16 tests at a time: gather both samples into byte vectors, compare, one bit per lane.
-  out.words = {0, 0, 0, 0};
-  for (int group = 0; group < 16; ++group, first += 16, second += 16) {
-    alignas(16) uint8_t a[16], b[16];
-    for (int j = 0; j < 16; ++j) {
-      a[j] = p[first[j]];
-      b[j] = p[second[j]];
-    }
-    const uint64_t bits = static_cast<uint32_t>(cv::v_signmask(cv::v_load_aligned(a) < cv::v_load_aligned(b)));
-    out.words[group / 4] |= bits << (16 * (group % 4));
+  // Test t is bit t % 64 of word t / 64, shifted in from the last test of a word down. Scalar
+  // compares, unrolled: ~7 instructions a test (two offsets, a byte load, a compare with memory,
+  // setb, a widening, lea); gathering 16 samples into byte vectors for one vector compare cost
+  // ~11 (GCC assembles the gathered bytes with shifts and ors).
+  for (int word = 0; word < 4; ++word, first += 64, second += 64) {
+    uint64_t bits = 0;
+#pragma GCC unroll 64
+    for (int j = 63; j >= 0; --j) bits = bits + bits + static_cast<uint64_t>(p[first[j]] < p[second[j]]);
+    out.words[word] = bits;
   }
 }
 
