@@ -43,20 +43,37 @@ void computeLineDescriptor(const cv::Mat& image, const cv::Point2f& start, const
     const float step_x = dx / positions, step_y = dy / positions;
     float fx = start.x + 0.5f * step_x + offset * nx + 0.5f, fy = start.y + 0.5f * step_y + offset * ny + 0.5f;
     const int half_end[2] = {(positions + 1) / 2, positions};  // 2k >= positions: second half
+    // Whether every sample of the row is inside (x, y in [1, max]): the positions are monotone in
+    // k (adding a constant step rounds monotonically), so the first and the last decide; the last
+    // is estimated as fx + (positions - 1) step, within `margin` of the running sum's value. Rows
+    // inside take the loop without the per-sample tests (the same samples either way). A sum of
+    // n float steps is within n half-ulps (<= 6e-8 |value| each) of the product form.
+    const float last_fx = fx + (positions - 1) * step_x, last_fy = fy + (positions - 1) * step_y;
+    const float magnitude = std::abs(fx) + std::abs(fy) + std::abs(last_fx) + std::abs(last_fy) + 1;
+    const float margin = 0.05f + 4e-7f * positions * magnitude;
+    const bool inside = std::min(fx, last_fx) >= 1 + margin && std::min(fy, last_fy) >= 1 + margin &&
+                        std::max(fx, last_fx) < x_max + 1 - margin && std::max(fy, last_fy) < y_max + 1 - margin;
     for (int part = 0, k = 0; part < 2; ++part) {
       // Lanes (across+, across-, along+, along-): the sample's projections onto (n, -n, u, -u),
       // clamped at 0, added to the band's running sums in the same order as a scalar loop would
       // (negation is exact, and adding the +-0 of the other sign leaves a sum unchanged).
       float* s = stats.data() + 4 * part;
       cv::v_float32x4 sums = cv::v_load(s);
-      for (; k < half_end[part]; ++k, fx += step_x, fy += step_y) {
-        if (fx < 1 || fy < 1) continue;
-        const int x = static_cast<int>(fx), y = static_cast<int>(fy);
-        if (x < 1 || y < 1 || x > x_max || y > y_max) continue;
+      auto add = [&](int x, int y) {
         const uint8_t* p = data + y * stride + x;
         const cv::v_float32x4 gx = cv::v_setall_f32(static_cast<float>(p[1] - p[-1]));
         const cv::v_float32x4 gy = cv::v_setall_f32(static_cast<float>(p[stride] - p[-stride]));
         sums += cv::v_max((gx * x_proj + gy * y_proj) * v_weight, v_zero);
+      };
+      if (inside) {
+        for (; k < half_end[part]; ++k, fx += step_x, fy += step_y) add(static_cast<int>(fx), static_cast<int>(fy));
+      } else {
+        for (; k < half_end[part]; ++k, fx += step_x, fy += step_y) {
+          if (fx < 1 || fy < 1) continue;
+          const int x = static_cast<int>(fx), y = static_cast<int>(fy);
+          if (x < 1 || y < 1 || x > x_max || y > y_max) continue;
+          add(x, y);
+        }
       }
       cv::v_store(s, sums);
     }
