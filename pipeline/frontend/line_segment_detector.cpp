@@ -12,9 +12,11 @@ namespace {
 constexpr int kBins = 1024;
 // Free = 1 so that a row of three states is directly a bit mask of the free pixels.
 constexpr uint8_t kFree = 1, kUsed = 0;
-// The region growing reads the states of p - 1 .. p + 2 as one little-endian word, so the state
-// array has one byte before pixel 0 and three after the last pixel.
-constexpr int kStateFront = 1, kStateBack = 3;
+// The region growing reads the states of the 3x3 neighbourhood as three little-endian words
+// (p - w - 1 .. p - w + 2, p - 1 .. p + 2, p + w - 1 .. p + w + 2), so the state array has a used
+// row and one byte before pixel 0 (stateFront) and three bytes after the last pixel.
+constexpr int kStateBack = 3;
+int stateFront(int width) { return width + 1; }
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "freeBits reads states as a little-endian word");
 
 // The states of 4 pixels from the 4-bit mask of which are above the threshold (bit i: pixel i).
@@ -50,7 +52,7 @@ LineSegmentDetector::LineSegmentDetector(int max_width, int max_height, const Li
   magnitude_.resize(n);
   dir_x_.resize(n);
   dir_y_.resize(n);
-  state_.resize(n + kStateFront + kStateBack, kUsed);
+  state_.resize(n + stateFront(max_width) + kStateBack, kUsed);
   bucket_start_.resize(kBins + 1);
   ordered_.resize(n);
   region_.resize(n);
@@ -80,7 +82,7 @@ int LineSegmentDetector::detect(const cv::Mat& image, float min_length, Detected
     float* mag = magnitude_.data() + y * w;
     float* ux = dir_x_.data() + y * w;
     float* uy = dir_y_.data() + y * w;
-    uint8_t* st = state_.data() + kStateFront + y * w;
+    uint8_t* st = state_.data() + stateFront(w) + y * w;
     if (y == h - 1) {
       std::fill_n(mag, w, 0.f);
       std::fill_n(st, w, kUsed);
@@ -134,7 +136,8 @@ int LineSegmentDetector::detect(const cv::Mat& image, float min_length, Detected
   const float* magnitude = magnitude_.data();
   const float* dir_x = dir_x_.data();
   const float* dir_y = dir_y_.data();
-  uint8_t* state = state_.data() + kStateFront;
+  uint8_t* state = state_.data() + stateFront(w);
+  std::fill_n(state - stateFront(w), stateFront(w), kUsed);  // the row above (a wider image may have written it)
   int* candidate = candidate_.data();
   uint16_t* candidate_bin = candidate_bin_.data();
   int candidates = 0;
@@ -150,6 +153,8 @@ int LineSegmentDetector::detect(const cv::Mat& image, float min_length, Detected
   for (int k = 0; k < candidates; ++k) ordered[bucket_start[candidate_bin[k]]++] = candidate[k];
 
   const int neighbour_offset[9] = {-w - 1, -w, -w + 1, -1, 0, 1, w - 1, w, w + 1};
+  static constexpr int8_t kNeighbourDx[9] = {-1, 0, 1, -1, 0, 1, -1, 0, 1};
+  static constexpr int8_t kNeighbourDy[9] = {-1, -1, -1, 0, 0, 0, 1, 1, 1};
   int* region = region_.data();
   int16_t* region_x = region_x_.data();
   int16_t* region_y = region_y_.data();
@@ -177,11 +182,10 @@ int LineSegmentDetector::detect(const cv::Mat& image, float min_length, Detected
         std::memcpy(&v, state + i - 1, 4);
         return (v & 1u) | ((v >> 7) & 2u) | ((v >> 14) & 4u);
       };
-      uint32_t mask = freeBits(p) << 3;
-      if (py > 0) mask |= freeBits(p - w);
-      if (py < h - 1) mask |= freeBits(p + w) << 6;
-      if (px == 0) mask &= ~0111u;  // no left column
-      if (px == w - 1) mask &= ~0444u;  // no right column
+      // No edge tests: the last row and column are always used, so a region pixel is never on
+      // them, and its missing neighbours read used states: the row above row 0 is the used front
+      // row, and left of column 0 lies the previous row's used last column.
+      uint32_t mask = freeBits(p - w) | freeBits(p) << 3 | freeBits(p + w) << 6;
       while (mask != 0) {
         const int bit = __builtin_ctz(mask);
         mask &= mask - 1;
@@ -189,8 +193,8 @@ int LineSegmentDetector::detect(const cv::Mat& image, float min_length, Detected
         if (dir_x[q] * sum_x + dir_y[q] * sum_y < bound) continue;
         state[q] = kUsed;
         region[size] = q;
-        region_x[size] = static_cast<int16_t>(px + bit % 3 - 1);
-        region_y[size] = static_cast<int16_t>(py + bit / 3 - 1);
+        region_x[size] = static_cast<int16_t>(px + kNeighbourDx[bit]);
+        region_y[size] = static_cast<int16_t>(py + kNeighbourDy[bit]);
         ++size;
         sum_x += dir_x[q];
         sum_y += dir_y[q];
