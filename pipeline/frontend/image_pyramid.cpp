@@ -49,6 +49,40 @@ bool cpuHasShuffle() {
 }  // namespace
 #endif
 
+namespace {
+
+// Pieces of the blur both of its paths share: the columns left to scalar code after the vector
+// blocks, and the mirrored columns past an image edge. T: the vertical result's element type.
+int reflect101(int i, int n) { return i < 0 ? -i : (i >= n ? 2 * n - 2 - i : i); }
+
+template <class T>
+void blurVerticalScalar(const uint8_t* const* r, const int* k, int from, int to, T* t) {
+  for (int x = from; x < to; ++x) {
+    int acc = 0;
+    for (int i = 0; i < 7; ++i) acc += k[i] * r[i][x];
+    t[x] = static_cast<T>((acc + 128) >> 8);
+  }
+}
+
+template <class T>
+void mirrorEdges(T* t, int w, int x0, int x1) {  // the horizontal pass reads t[x0 - 3 .. x1 + 2]
+  for (int i = 1; i <= 3; ++i) {
+    if (x0 < 3) t[-i] = t[reflect101(-i, w)];
+    if (x1 + 3 > w) t[w - 1 + i] = t[reflect101(w - 1 + i, w)];
+  }
+}
+
+template <class T>
+void blurHorizontalScalar(const T* t, const int* k, int from, int to, uint8_t* d) {
+  for (int x = from; x < to; ++x) {
+    int acc = 0;
+    for (int i = 0; i < 7; ++i) acc += k[i] * t[x + i - 3];
+    d[x] = static_cast<uint8_t>((acc + 128) >> 8);
+  }
+}
+
+}  // namespace
+
 #if PLUMB_PYRAMID_SHUFFLE && defined(__x86_64__)
 namespace {
 
@@ -116,29 +150,17 @@ PLUMB_PYRAMID_SHUFFLE_TARGET void blurByteMultiplyAdd(const cv::Mat& src, cv::Ma
                                                       int y1, const std::array<int, 7>& kernel, uint8_t* t) {
   // t: the byte row, valid on [-3, w + 3) after the edge mirroring below.
   const int w = src.cols, h = src.rows;
-  auto reflect = [](int i, int n) { return i < 0 ? -i : (i >= n ? 2 * n - 2 - i : i); };  // REFLECT_101
   const ByteWeights weights(kernel);
   const int vx0 = std::max(x0 - 3, 0), vx1 = std::min(x1 + 3, w);
   const uint8_t* columns[7];  // the horizontal pass: t shifted by -3 .. 3
   for (int i = 0; i < 7; ++i) columns[i] = t + i - 3;
   for (int y = y0; y < y1; ++y) {
     const uint8_t* r[7];
-    for (int i = 0; i < 7; ++i) r[i] = src.ptr<uint8_t>(reflect(y + i - 3, h));
-    for (int x = blurBlocks(r, vx0, vx1, weights, t); x < vx1; ++x) {
-      int acc = 0;
-      for (int i = 0; i < 7; ++i) acc += kernel[i] * r[i][x];
-      t[x] = static_cast<uint8_t>((acc + 128) >> 8);
-    }
-    for (int i = 1; i <= 3; ++i) {  // the horizontal pass reads t[x0 - 3 .. x1 + 2]
-      if (x0 < 3) t[-i] = t[reflect(-i, w)];
-      if (x1 + 3 > w) t[w - 1 + i] = t[reflect(w - 1 + i, w)];
-    }
+    for (int i = 0; i < 7; ++i) r[i] = src.ptr<uint8_t>(reflect101(y + i - 3, h));
+    blurVerticalScalar(r, kernel.data(), blurBlocks(r, vx0, vx1, weights, t), vx1, t);
+    mirrorEdges(t, w, x0, x1);
     uint8_t* d = dst.ptr<uint8_t>(y);
-    for (int x = blurBlocks(columns, x0, x1, weights, d); x < x1; ++x) {
-      int acc = 0;
-      for (int i = 0; i < 7; ++i) acc += kernel[i] * t[x + i - 3];
-      d[x] = static_cast<uint8_t>((acc + 128) >> 8);
-    }
+    blurHorizontalScalar(t, kernel.data(), blurBlocks(columns, x0, x1, weights, d), x1, d);
   }
 }
 
@@ -374,7 +396,6 @@ void ImagePyramid::blur(const cv::Mat& src, cv::Mat& dst, int x0, int y0, int x1
   const int w = src.cols, h = src.rows;
   x0 = std::max(x0, 0), y0 = std::max(y0, 0), x1 = std::min(x1, w), y1 = std::min(y1, h);
   if (x0 >= x1 || y0 >= y1) return;
-  auto reflect = [](int i, int n) { return i < 0 ? -i : (i >= n ? 2 * n - 2 - i : i); };  // REFLECT_101
   // The vertical pass covers the columns the horizontal one reads, [x0 - 3, x1 + 3) inside the
   // image; the 3 columns past an image edge are mirrored from inside it afterwards.
   const int vx0 = std::max(x0 - 3, 0), vx1 = std::min(x1 + 3, w);
@@ -390,7 +411,7 @@ void ImagePyramid::blur(const cv::Mat& src, cv::Mat& dst, int x0, int y0, int x1
   const int h_block_end = x1 - x0 >= 8 ? x1 : x0;
   for (int y = y0; y < y1; ++y) {
     const uint8_t* r[7];
-    for (int i = 0; i < 7; ++i) r[i] = src.ptr<uint8_t>(reflect(y + i - 3, h));
+    for (int i = 0; i < 7; ++i) r[i] = src.ptr<uint8_t>(reflect101(y + i - 3, h));
     // The kernel is symmetric: rows 3 - i and 3 + i are added first (<= 510) and multiplied
     // once, 4 multiplies instead of 7 for the same integer sum (<= 65280: no overflow).
     for (int x = vx0; x < v_block_end;) {
@@ -410,15 +431,8 @@ void ImagePyramid::blur(const cv::Mat& src, cv::Mat& dst, int x0, int y0, int x1
       cv::v_store(t + bx, (lo + half) >> 8);
       cv::v_store(t + bx + 8, (hi + half) >> 8);
     }
-    for (int x = v_block_end > vx0 ? vx1 : vx0; x < vx1; ++x) {
-      unsigned acc = 0;
-      for (int i = 0; i < 7; ++i) acc += k[i] * r[i][x];
-      t[x] = static_cast<uint16_t>((acc + 128) >> 8);
-    }
-    for (int i = 1; i <= 3; ++i) {  // the horizontal pass reads t[x0 - 3 .. x1 + 2]
-      if (x0 < 3) t[-i] = t[reflect(-i, w)];
-      if (x1 + 3 > w) t[w - 1 + i] = t[reflect(w - 1 + i, w)];
-    }
+    blurVerticalScalar(r, kernel_.data(), v_block_end > vx0 ? vx1 : vx0, vx1, t);
+    mirrorEdges(t, w, x0, x1);
     uint8_t* d = dst.ptr<uint8_t>(y);
     for (int x = x0; x < h_block_end;) {
       const int bx = std::min(x, h_block_end - 8);
@@ -427,11 +441,7 @@ void ImagePyramid::blur(const cv::Mat& src, cv::Mat& dst, int x0, int y0, int x1
       for (int i = 0; i < 3; ++i) acc += cv::v_mul_wrap(cv::v_load(t + bx + i - 3) + cv::v_load(t + bx + 3 - i), vk[i]);
       cv::v_pack_store(d + bx, (acc + half) >> 8);
     }
-    for (int x = h_block_end > x0 ? x1 : x0; x < x1; ++x) {
-      unsigned acc = 0;
-      for (int i = 0; i < 7; ++i) acc += k[i] * t[x + i - 3];
-      d[x] = static_cast<uint8_t>((acc + 128) >> 8);
-    }
+    blurHorizontalScalar(t, kernel_.data(), h_block_end > x0 ? x1 : x0, x1, d);
   }
 }
 
