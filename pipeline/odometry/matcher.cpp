@@ -45,7 +45,11 @@ bool pointOnLineNearRay(const PinholeCamera& camera, const Eigen::Vector3f& poin
 
 }  // namespace
 
-ProjectionMatcher::ProjectionMatcher(const MatcherOptions& options) : options_(options) {}
+ProjectionMatcher::ProjectionMatcher(const MatcherOptions& options) : options_(options) {
+  for (int octave = 0; octave < kPyramidLevels; ++octave) {
+    octave_scale_[octave] = std::pow(options_.scale_factor, static_cast<float>(octave));
+  }
+}
 
 int ProjectionMatcher::matchPoints(const PointCandidate* candidates, int count, const FrameFeatures& frame,
                                    PointMatches& out) {
@@ -59,7 +63,7 @@ int ProjectionMatcher::matchPoints(const PointCandidate* candidates, int count, 
   count = std::min(count, 65535);
   for (int c = 0; c < count; ++c) {
     const PointCandidate& cand = candidates[c];
-    const float radius = o.search_radius_px * std::pow(options_.scale_factor, static_cast<float>(cand.octave));
+    const float radius = o.search_radius_px * octaveScale(cand.octave);
     const float radius2 = radius * radius;
     int best = 1 << 20, second = 1 << 20, best_kp = -1, best_octave = -1, second_octave = -1;
     frame.keypoint_grid.forEachNear(cand.px_undist.x(), cand.px_undist.y(), radius, [&](int k) {
@@ -129,6 +133,16 @@ int ProjectionMatcher::matchLines(const LineCandidate* candidates, int count, co
   best_distance.fill(1 << 20);
   const float cos_max_angle = std::cos(o.max_angle_deg * static_cast<float>(M_PI) / 180.f);
   count = std::min(count, 65535);
+  // Per observed line, once instead of once per candidate (the same float operations, so the
+  // same values): its span, its length, and the angle test's bound.
+  std::array<Eigen::Vector2f, kMaxLines> obs_spans;
+  std::array<float, kMaxLines> obs_lengths, angle_bounds;
+  for (int k = 0; k < num_lines; ++k) {
+    const LineObservation& obs = frame.lines[k];
+    obs_spans[k] = obs.end_px - obs.start_px;
+    obs_lengths[k] = obs_spans[k].norm();
+    angle_bounds[k] = cos_max_angle * obs_lengths[k];
+  }
   for (int c = 0; c < count; ++c) {
     const LineCandidate& cand = candidates[c];
     const Eigen::Vector2f span = cand.end_px - cand.start_px;
@@ -138,11 +152,10 @@ int ProjectionMatcher::matchLines(const LineCandidate* candidates, int count, co
     const Eigen::Vector2f n(-u.y(), u.x());
     int best = 1 << 20, second = 1 << 20, best_line = -1;
     for (int k = 0; k < num_lines; ++k) {
-      const LineObservation& obs = frame.lines[k];
-      const Eigen::Vector2f obs_span = obs.end_px - obs.start_px;
-      const float obs_length = obs_span.norm();
+      const float obs_length = obs_lengths[k];
       if (obs_length < 1e-3f) continue;
-      if (std::abs(u.dot(obs_span)) < cos_max_angle * obs_length) continue;  // undirected angle
+      if (std::abs(u.dot(obs_spans[k])) < angle_bounds[k]) continue;  // undirected angle
+      const LineObservation& obs = frame.lines[k];
       const Eigen::Vector2f ds = obs.start_px - cand.start_px, de = obs.end_px - cand.start_px;
       if (std::abs(n.dot(ds)) > o.max_endpoint_distance_px || std::abs(n.dot(de)) > o.max_endpoint_distance_px) continue;
       const float t0 = std::min(u.dot(ds), u.dot(de)), t1 = std::max(u.dot(ds), u.dot(de));
