@@ -14,6 +14,8 @@
 // endpoints distances to the predicted infinite line are small, which overlap the predicted
 // segment along its direction, and whose LBD-style distance is below lbd_threshold with a ratio
 // test; each frame line used once.
+#include <array>
+#include <cmath>
 #include <cstdint>
 
 #include <Eigen/Core>
@@ -109,6 +111,12 @@ class ProjectionMatcher {
 
  private:
   MatcherOptions options_;
+  // scale_factor^octave for the octaves a pyramid has (std::pow once here, not per candidate).
+  std::array<float, kPyramidLevels> octave_scale_{};
+  float octaveScale(int octave) const {
+    return octave >= 0 && octave < kPyramidLevels ? octave_scale_[octave]
+                                                  : std::pow(options_.scale_factor, static_cast<float>(octave));
+  }
   // Scratch (members so nothing is allocated per call).
   PointCandidates point_candidates_;
   LineCandidates line_candidates_;

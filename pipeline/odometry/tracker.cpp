@@ -6,6 +6,7 @@
 
 #include "pipeline/odometry/keyframe_policy.h"
 #include "pipeline/odometry/tracker_rolling_shutter.h"
+#include "solver/noise_model.h"
 #include "solver/se3.h"
 
 namespace plumb {
@@ -42,6 +43,10 @@ Tracker::Tracker(const PinholeCamera& camera, const OdometryOptions& options)
   pose_options_.rounds = options.tracker.pose_rounds;
   pose_options_.iterations_per_round = options.tracker.pose_iterations_per_round;
   pose_options_.step_tolerance = options.tracker.pose_step_tolerance;
+  for (int octave = 0; octave < kPyramidLevels; ++octave) {
+    mono_point_information_[octave] = monoPointInformation(options.extractor.noise, octave);
+    line_sample_information_[octave] = lineSampleInformation(options.extractor.noise, octave);
+  }
   local_map_ = &b_->local_map;
   local_map_->clear();
 }

@@ -119,6 +119,12 @@ class Tracker {
   CameraIntrinsics intrinsics_;
   OdometryOptions options_;
   PoseOptimizerOptions pose_options_;
+  // The noise model's information of a 2D point and of a line sample per pyramid octave, made
+  // once (solver/noise_model.h computes a power per call); other octaves call it directly.
+  std::array<Eigen::Matrix2d, kPyramidLevels> mono_point_information_;
+  std::array<double, kPyramidLevels> line_sample_information_{};
+  Eigen::Matrix2d monoInformation(int octave) const;
+  double lineInformation(int octave) const;
   ProjectionMatcher matcher_;        // constant-velocity window
   ProjectionMatcher wide_matcher_;   // retries
   ProjectionMatcher local_matcher_;  // local-map window

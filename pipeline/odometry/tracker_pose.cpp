@@ -21,6 +21,16 @@ double Tracker::mapShare(int local_index, bool point) const {
   return 1.0 / double(std::max(n, 1));
 }
 
+Eigen::Matrix2d Tracker::monoInformation(int octave) const {
+  return octave >= 0 && octave < kPyramidLevels ? mono_point_information_[octave]
+                                                : monoPointInformation(options_.extractor.noise, octave);
+}
+
+double Tracker::lineInformation(int octave) const {
+  return octave >= 0 && octave < kPyramidLevels ? line_sample_information_[octave]
+                                                : lineSampleInformation(options_.extractor.noise, octave);
+}
+
 PoseResult Tracker::optimizeAndPrune(const FrameFeatures& frame, const Eigen::Isometry3d& T_cam_world,
                                      TrackResult* result, bool final_pose) {
   const NoiseModelOptions& noise = options_.extractor.noise;
@@ -47,7 +57,7 @@ PoseResult Tracker::optimizeAndPrune(const FrameFeatures& frame, const Eigen::Is
       }
     } else {
       obs->information.setZero();
-      obs->information.topLeftCorner<2, 2>() = monoPointInformation(noise, kp.octave);
+      obs->information.topLeftCorner<2, 2>() = monoInformation(kp.octave);
     }
     obs->map_share = mapShare(b_->points[k].local_index, true);
     (void)point_keypoint.push_back(uint16_t(k));
@@ -56,7 +66,7 @@ PoseResult Tracker::optimizeAndPrune(const FrameFeatures& frame, const Eigen::Is
     for (std::size_t k = 0; k < frame.lines.size(); ++k) {
       const LineAssociation& a = b_->lines[k];
       if (!a.valid) continue;
-      const double information = lineSampleInformation(noise, frame.lines[k].octave);
+      const double information = lineInformation(frame.lines[k].octave);
       const double map_share = mapShare(a.local_index, false);
       for (int s = 0; s < a.num_samples; ++s) {
         PoseLineObservation* obs = lines.emplace_back();
