@@ -13,6 +13,15 @@ struct UncertaintyOptions {
   // Scale BA's and pose-only's covariances by their a posteriori variance factor sigma0^2
   // (solver/variance_factor.h): the noise level the residuals show instead of the model's.
   bool use_variance_factor = true;
+  // Local BA only: instead of one pooled factor, the points' pixel residuals and their depth
+  // (disparity) residuals each get their own a posteriori factor (variance components: two
+  // independent sensors whose model errors differ, e.g. a rendering's corners are 3x better than
+  // the 1 px model and its depth is as modelled), and line samples keep the model's information:
+  // their residuals cannot show their noise (each sample's own 3D point absorbs all but V - 2 of
+  // its V residuals, and the samples of one line share the one 2D line of each image), yet pooled
+  // they counted as redundancy and pulled everyone's factor down (synth office scenes: 0.16
+  // pooled, 0.30 from points alone). docs/UNCERTAINTY.md "Variance components".
+  bool variance_components = true;
   // Scale on local BA's relative-pose covariance (keyframe to keyframe) and model-error floor
   // sigmas added to it (independent per keyframe pair).
   // 1.8 / 1.5: Monte Carlo calibration on synthetic scenes (docs/UNCERTAINTY.md): the errors of

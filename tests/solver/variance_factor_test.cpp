@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 
+#include "solver/noise_model.h"
 #include "solver/variance_factor.h"
 #include "tests/support/synthetic_window.h"
 
@@ -66,6 +67,45 @@ TEST(VarianceFactor, LocalBaSeesNoiseBelowTheModel) {
   testing::loadWindow(w1, true, &ba1);
   ASSERT_TRUE(ba1.solve(options).ok());
   EXPECT_NEAR(ba1.varianceFactor(options), 1.0, 0.2);
+}
+
+// Variance components: pixel noise at half the model (component 0.25), depth noise at the model
+// (1.0). Each part gets its own factor; the pooled factor lies in between and fits neither.
+TEST(VarianceFactor, LocalBaSeparatesPixelAndDepthComponents) {
+  testing::SyntheticWindowConfig config;
+  config.pixel_noise = 0.5;
+  const testing::SyntheticWindow w = testing::makeSyntheticWindow(config);
+  LocalBundleAdjuster ba;
+  testing::loadWindow(w, true, &ba);
+  LocalBaOptions options;
+  ASSERT_TRUE(ba.solve(options).ok());
+  const PointVarianceComponents c = ba.varianceComponents(options);
+  EXPECT_GT(c.redundancy, 100.0);
+  EXPECT_NEAR(c.pixel, 0.25, 0.06);
+  EXPECT_NEAR(c.depth, 1.0, 0.25);
+  const double pooled = ba.varianceFactor(options);
+  EXPECT_GT(pooled, c.pixel + 0.05);
+  EXPECT_LT(pooled, c.depth - 0.1);
+}
+
+// The stereo information split into pixel and disparity parts: the parts' chi2 add up to the whole
+// for the model's information, and scaling both parts by s is scaling the information by s.
+TEST(VarianceFactor, StereoInformationSplitsIntoPixelAndDepth) {
+  const CameraIntrinsics camera{525.0, 525.0, 319.5, 239.5, 525.0 * 0.08};
+  const NoiseModelOptions noise;
+  const Eigen::Matrix3d information = stereoPointInformation(noise, camera, 1, 2.5);
+  const Eigen::Vector3d e(0.7, -0.4, 1.9);
+  double pixel = 0, depth = 0;
+  splitStereoChi2(information, e, &pixel, &depth);
+  EXPECT_NEAR(pixel + depth, e.dot(information * e), 1e-9 * e.dot(information * e));
+  EXPECT_NEAR(pixel, (0.49 + 0.16) / std::pow(pixelSigma(noise, 1), 2), 1e-9);
+  EXPECT_TRUE(scaleStereoInformation(information, 3.0, 3.0).isApprox(3.0 * information, 1e-12));
+  // Depth scaled alone: the pixel part of the chi2 is unchanged, the depth part scaled.
+  const Eigen::Matrix3d depth_scaled = scaleStereoInformation(information, 1.0, 0.25);
+  double pixel2 = 0, depth2 = 0;
+  splitStereoChi2(depth_scaled, e, &pixel2, &depth2);
+  EXPECT_NEAR(pixel2, pixel, 1e-9 * pixel);
+  EXPECT_NEAR(depth2, 0.25 * depth, 1e-9 * depth);
 }
 
 }  // namespace
