@@ -49,36 +49,32 @@ TEST(VarianceFactor, RecoversTheScaleOfTruncatedChiSquareSums) {
 
 // A window whose pixel noise is half the model's 1 px: sigma0^2 ~ 0.25 for the pixel-dominated
 // errors (depth noise is drawn at the model's level, so the result lies between 0.25 and 1).
-TEST(VarianceFactor, LocalBaSeesNoiseBelowTheModel) {
+// The default synthetic window (depth noise drawn from the model) with this pixel noise, solved.
+void solveWindow(double pixel_noise, const LocalBaOptions& options, LocalBundleAdjuster* ba) {
   testing::SyntheticWindowConfig config;
-  config.pixel_noise = 0.5;
-  const testing::SyntheticWindow w = testing::makeSyntheticWindow(config);
+  config.pixel_noise = pixel_noise;
+  testing::loadWindow(testing::makeSyntheticWindow(config), true, ba);
+  ASSERT_TRUE(ba->solve(options).ok());
+}
+
+TEST(VarianceFactor, LocalBaSeesNoiseBelowTheModel) {
+  const LocalBaOptions options;
   LocalBundleAdjuster ba;
-  testing::loadWindow(w, true, &ba);
-  LocalBaOptions options;
-  ASSERT_TRUE(ba.solve(options).ok());
+  solveWindow(0.5, options, &ba);
   const double s = ba.varianceFactor(options);
   EXPECT_GT(s, 0.15);
   EXPECT_LT(s, 0.8);
-  testing::SyntheticWindowConfig model_noise = config;
-  model_noise.pixel_noise = 1.0;
-  const testing::SyntheticWindow w1 = testing::makeSyntheticWindow(model_noise);
   LocalBundleAdjuster ba1;
-  testing::loadWindow(w1, true, &ba1);
-  ASSERT_TRUE(ba1.solve(options).ok());
+  solveWindow(1.0, options, &ba1);
   EXPECT_NEAR(ba1.varianceFactor(options), 1.0, 0.2);
 }
 
 // Variance components: pixel noise at half the model (component 0.25), depth noise at the model
 // (1.0). Each part gets its own factor; the pooled factor lies in between and fits neither.
 TEST(VarianceFactor, LocalBaSeparatesPixelAndDepthComponents) {
-  testing::SyntheticWindowConfig config;
-  config.pixel_noise = 0.5;
-  const testing::SyntheticWindow w = testing::makeSyntheticWindow(config);
+  const LocalBaOptions options;
   LocalBundleAdjuster ba;
-  testing::loadWindow(w, true, &ba);
-  LocalBaOptions options;
-  ASSERT_TRUE(ba.solve(options).ok());
+  solveWindow(0.5, options, &ba);
   const PointVarianceComponents c = ba.varianceComponents(options);
   EXPECT_GT(c.redundancy, 100.0);
   EXPECT_NEAR(c.pixel, 0.25, 0.06);
