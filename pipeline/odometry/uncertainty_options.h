@@ -20,7 +20,8 @@ struct UncertaintyOptions {
   // their residuals cannot show their noise (each sample's own 3D point absorbs all but V - 2 of
   // its V residuals, and the samples of one line share the one 2D line of each image), yet pooled
   // they counted as redundancy and pulled everyone's factor down (synth office scenes: 0.16
-  // pooled, 0.30 from points alone). docs/UNCERTAINTY.md "Variance components".
+  // pooled, 0.30 from points alone). docs/UNCERTAINTY.md "Variance components". relative_scale
+  // is calibrated WITH this on; with it off (the pooled factor) the calibrated value was 1.8.
   bool variance_components = true;
   // Scale on local BA's relative-pose covariance (keyframe to keyframe) and model-error floor
   // sigmas added to it (independent per keyframe pair).
