@@ -144,6 +144,7 @@ void LoopCloser::addNode(const LoopKeyframe& r, int slot) {
   n.id = r.id;
   n.timestamp_s = r.timestamp_s;
   n.T_world_record = r.T_world_cam;
+  n.T_world_mapping = r.T_world_cam;
   if (order_.empty()) {
     n.T_world_cam = r.T_world_cam;  // the graph's frame is the first keyframe's mapping frame
   } else {
@@ -156,7 +157,7 @@ void LoopCloser::addNode(const LoopKeyframe& r, int slot) {
     } else {
       // A new segment, or the previous keyframe's record never arrived (full ring): the relative
       // pose of the two records as the mapping side had them, with the weak segment covariance.
-      n.T_previous_this = previous.T_world_record.inverse() * r.T_world_cam;
+      n.T_previous_this = previous.T_world_mapping.inverse() * r.T_world_cam;
       n.edge_covariance =
           diagonalCovariance(options_.segment_translation_sigma_m, options_.segment_rotation_sigma_rad);
     }
@@ -382,7 +383,7 @@ void LoopCloser::optimise() {
     if (c >= 0) {
       const Node& candidate = nodes_[std::size_t(order_[std::size_t(c)])];
       const LoopEdge& edge = loop_edges_.back();
-      const Eigen::Isometry3d T_world_loop = candidate.T_world_record * edge.T_candidate_query;
+      const Eigen::Isometry3d T_world_loop = candidate.T_world_mapping * edge.T_candidate_query;
       correction_.T_world_cam = T_world_loop;
       if (options_.fuse_realtime_correction) {
         // Minimum-variance update of the query's pose as the robot has it (T_odo: its record) with
@@ -395,8 +396,8 @@ void LoopCloser::optimise() {
         const Matrix6d S_odo = odometryCovariance(c, int(order_.size()) - 1, false);
         const Matrix6d S_loop = inverseSpd(edge.information);
         const Matrix6d K = S_odo * inverseSpd(S_odo + S_loop);
-        const Eigen::Isometry3d T_cw_odo = query.T_world_record.inverse();
-        const Vector6d d = logSE3(T_world_loop.inverse() * query.T_world_record);
+        const Eigen::Isometry3d T_cw_odo = query.T_world_mapping.inverse();
+        const Vector6d d = logSE3(T_world_loop.inverse() * query.T_world_mapping);
         const Vector6d step = K * d;
         if (step.allFinite()) correction_.T_world_cam = applyLeftIncrement(step, T_cw_odo).inverse();
       }

@@ -194,6 +194,11 @@ class LoopCloser {
     double timestamp_s = 0;  // the record's (0 for a keyframe loaded from a map file)
     Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();     // graph estimate
     Eigen::Isometry3d T_world_record = Eigen::Isometry3d::Identity();  // the record's, at creation
+    // Where THIS run's mapping frame had the keyframe: the record's pose for a keyframe of this run,
+    // the loaded (optimised) pose for one of a loaded map, which the run relocalizes against. It
+    // links the mapping frame to the graph (a new segment's first node, the real-time correction's
+    // anchor); T_world_record is kept as written, for the map file.
+    Eigen::Isometry3d T_world_mapping = Eigen::Isometry3d::Identity();
     bool has_edge = false;                                          // from the previous node in order_
     Eigen::Isometry3d T_previous_this = Eigen::Isometry3d::Identity();
     Matrix6d edge_covariance = Matrix6d::Identity();  // of this node, previous held fixed

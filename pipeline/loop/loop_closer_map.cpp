@@ -100,6 +100,10 @@ Status LoopCloser::restoreMap(const SavedMap& map) {
     n.timestamp_s = k.record.timestamp_s;
     n.T_world_cam = k.T_world_cam;
     n.T_world_record = k.record.T_world_cam;
+    // The loading run's mapping frame is the map's graph frame (it relocalizes against these
+    // keyframes at their optimised poses), not the first run's real-time frame its records were
+    // made in: those differ by that run's corrections and final optimisation.
+    n.T_world_mapping = k.T_world_cam;
     n.has_edge = k.has_edge;
     n.T_previous_this = k.T_previous_this;
     n.edge_covariance = k.edge_covariance;

@@ -169,8 +169,8 @@ TEST(SolverKernels, RankOneLineSampleBlocksEqualTheGeneralForms) {
     subtractScaledOuter(gamma, u_vec[1].data(), u_vec[0].data(), S.data(), 6);
     // gamma = r_1^T H^-1 r_0 can cancel to far below its terms, so the two orders of summation
     // agree to eps times the size of the terms, not of the result: scale by the factors' norms.
-    // (CI failed at 3.7e-12 relative to the result once: glibc picks sin/cos by CPU, so R, and
-    // with it the cancellation, differs in the last bits between machines.)
+    // (The aarch64 build failed at 3.7e-12 relative to the result under qemu in CI: GCC fuses
+    // a * b + c into FMA there, so the last bits, and with them the cancellation, differ.)
     const double term_scale = W[1].norm() * H_inv.norm() * W[0].norm();
     ASSERT_LT((S - expected).norm() / std::max(1.0, term_scale), kTolerance) << n;
     const Matrix6d expected_diagonal = -(W[0] * H_inv) * W[0].transpose();

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -119,6 +120,28 @@ TEST(MapFile, RoundTripThroughTheLoopCloserIsByteExact) {
   EXPECT_EQ(fileBytes(exported), first);
   // A closer refuses a second map (it is not empty any more).
   EXPECT_FALSE(closer.restoreMap(decoded).ok());
+}
+
+// The loading run relocalizes against the loaded keyframes at their OPTIMISED poses, so its mapping
+// frame is the map's graph frame: a new keyframe of that run enters the graph at its own pose. (It
+// was placed through the last loaded keyframe's real-time record, which the example map draws
+// independently of its optimised pose, as a first run's corrections make them differ: the whole
+// second run's optimised output moved by that difference; docs/LOOP.md "Map files".)
+TEST(MapFile, ANewKeyframeAfterALoadedMapEntersTheGraphAtItsOwnPose) {
+  loop::SavedMap map;
+  makeExampleMap(7, 6, 10, 2, 1, &map);
+  ASSERT_FALSE(map.keyframes.back()->record.T_world_cam.isApprox(map.keyframes.back()->T_world_cam, 1e-3));
+  loop::LoopCloser closer = makeCloser();
+  ASSERT_TRUE(closer.restoreMap(map).ok());
+  auto record = std::make_unique<loop::LoopKeyframe>();
+  record->id = map.maxKeyframeId() + 40;
+  record->new_segment = true;
+  record->T_world_cam = map.keyframes.back()->T_world_cam *
+                        Eigen::Isometry3d(Eigen::Translation3d(0.1, -0.05, 0.2) * Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitY()));
+  (void)closer.addKeyframe(*record);
+  Eigen::Isometry3d T;
+  ASSERT_TRUE(closer.pose(record->id, &T));
+  EXPECT_TRUE(T.isApprox(record->T_world_cam, 1e-12)) << T.matrix() << "\n" << record->T_world_cam.matrix();
 }
 
 TEST(MapFile, RestoreRefusesWhatTheCloserCannotHold) {
