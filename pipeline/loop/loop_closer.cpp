@@ -127,13 +127,19 @@ bool LoopCloser::finalPose(uint32_t keyframe_id, Eigen::Isometry3d* T_world_cam,
   return true;
 }
 
-Matrix6d LoopCloser::edgeCovariance(bool new_segment, const Matrix6d& covariance,
-                                    bool covariance_valid) const {
+Matrix6d LoopCloser::edgeCovariance(bool new_segment, const Matrix6d& covariance, bool covariance_valid) {
   if (new_segment)
     return diagonalCovariance(options_.segment_translation_sigma_m, options_.segment_rotation_sigma_rad);
   if (covariance_valid && finiteSpd(covariance)) {
-    return 0.5 * (covariance + covariance.transpose()) +
-           diagonalCovariance(options_.odometry_floor_translation_sigma_m, options_.odometry_floor_rotation_sigma_rad);
+    const Matrix6d symmetric = 0.5 * (covariance + covariance.transpose());
+    const double max_t = options_.max_edge_translation_sigma_m, max_r = options_.max_edge_rotation_sigma_rad;
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> t(symmetric.topLeftCorner<3, 3>(), Eigen::EigenvaluesOnly);
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> r(symmetric.bottomRightCorner<3, 3>(), Eigen::EigenvaluesOnly);
+    if (t.eigenvalues().maxCoeff() <= max_t * max_t && r.eigenvalues().maxCoeff() <= max_r * max_r) {
+      return symmetric +
+             diagonalCovariance(options_.odometry_floor_translation_sigma_m, options_.odometry_floor_rotation_sigma_rad);
+    }
+    ++stats_.edge_covariances_refused;
   }
   return diagonalCovariance(options_.default_translation_sigma_m, options_.default_rotation_sigma_rad);
 }

@@ -71,9 +71,17 @@ struct LoopCloserOptions {
   int cooldown_keyframes = 3;         // after an accepted loop, keyframes not searched
   LoopVerifierOptions verifier;
   int bits_per_word = kDefaultWordBits;
-  // Odometry edge covariance when local BA gave none.
+  // Odometry edge covariance when local BA gave none, or gave one beyond the bounds below.
   double default_translation_sigma_m = 0.02;
   double default_rotation_sigma_rad = 0.01;
+  // A BA relative covariance whose largest translation or rotation sigma exceeds these is refused
+  // as an edge weight (the default above is used and `edge_covariances_refused` counts it): a
+  // near-singular window can give an SPD covariance of 1e9 m^2, and the graph's LM then stops with
+  // that almost weightless edge unsatisfied, leaving a rigid step in the optimised chain even
+  // without a loop (docs/UNCERTAINTY.md "Variance components in local BA: tried, not shipped").
+  // Consecutive keyframes are centimetres apart: a 1 m or 0.5 rad sigma is no measurement.
+  double max_edge_translation_sigma_m = 1.0;
+  double max_edge_rotation_sigma_rad = 0.5;
   // Added to BA's covariance of an odometry edge: numerical only (every edge's information stays
   // finite), 30x and 20x below the 3 mm / 0.002 rad model floor these edges had before. BA's
   // relative covariances are calibrated (variance factor, correlation factor, rolling-shutter
@@ -128,6 +136,7 @@ struct LoopStats {
   uint64_t rejected[kNumLoopRejections] = {};  // by LoopRejection (index 0 unused)
   uint64_t culled = 0;
   uint64_t edges_refined = 0;  // odometry edges replaced by final local-map poses
+  uint64_t edge_covariances_refused = 0;  // BA covariances beyond the options' bounds (default used)
   uint64_t optimisations = 0;
   double optimisation_ms_total = 0;
   double optimisation_ms_max = 0;
@@ -232,7 +241,7 @@ class LoopCloser {
   bool confirmNewestLoop();
   // The loop edge's covariance is within max_loop_sigma_m / max_loop_sigma_rad.
   bool certain(const Matrix6d& covariance) const;
-  Matrix6d edgeCovariance(bool new_segment, const Matrix6d& covariance, bool covariance_valid) const;
+  Matrix6d edgeCovariance(bool new_segment, const Matrix6d& covariance, bool covariance_valid);
 
   LoopCloserOptions options_;
   LoopVerifier verifier_;

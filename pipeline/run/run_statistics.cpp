@@ -133,8 +133,10 @@ std::string runSummaryJson(const RunSummary& r) {
     }
     out += "},\n";
     add(std::snprintf(buf, sizeof(buf),
-                      "    \"edges_refined\": %" PRIu64 ", \"optimisations\": %" PRIu64 ", \"optimisation_ms_total\": %.3f, \"optimisation_ms_max\": %.3f},\n",
-                      ls.edges_refined, ls.optimisations, ls.optimisation_ms_total, ls.optimisation_ms_max));
+                      "    \"edges_refined\": %" PRIu64 ", \"edge_covariances_refused\": %" PRIu64
+                      ", \"optimisations\": %" PRIu64 ", \"optimisation_ms_total\": %.3f, \"optimisation_ms_max\": %.3f},\n",
+                      ls.edges_refined, ls.edge_covariances_refused, ls.optimisations, ls.optimisation_ms_total,
+                      ls.optimisation_ms_max));
     out += loopAuditJson(lr) + ",\n";
   }
   if (r.map_loaded || !r.map_saved_path.empty()) {

@@ -81,6 +81,44 @@ TEST(LoopCloser, ClosesADriftedLoopAndCorrectsTheGraph) {
 // the first keyframe that may have a candidate at all. The two queries before it list the place
 // for the consistency count only (early_consistency), so the loop closes right there; without it
 // the count of 3 consecutive queries cannot be met before id 36, two keyframes past the revisit.
+// A near-singular local-BA window can hand the closer a finite, positive definite relative
+// covariance of 1e9 m^2. As an edge weight it let the graph's LM stop with that edge unsatisfied:
+// without any loop, the chain after it kept its drifted record poses (a rigid step in the
+// optimised trajectory). Such a covariance is refused and counted; the chain of final poses is
+// then re-chained exactly.
+TEST(LoopCloser, ADegenerateEdgeCovarianceIsRefusedAndTheChainStaysExact) {
+  const Scene scene = cylinderScene(21, 6000, 3.5);
+  constexpr int kKeyframes = 24, kDegenerate = 12;
+  auto pose_at = [&](int k) { return outwardPose(2 * M_PI * k / 100, 1.0); };
+  loop::LoopCloserOptions options;
+  options.capacity = 64;
+  loop::LoopCloser closer = makeCloser(options);
+  Eigen::Isometry3d T_odometry = pose_at(0);
+  for (int k = 0; k < kKeyframes; ++k) {
+    Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+    if (k > 0) {
+      step = driftedStep(pose_at(k - 1).inverse() * pose_at(k));
+      T_odometry = T_odometry * step;
+    }
+    (void)closer.addKeyframe(*recordOf(scene, uint32_t(k + 1), pose_at(k), T_odometry, k > 0 ? uint32_t(k) : 0, step));
+  }
+  ASSERT_EQ(closer.stats().loops_accepted, 0u);
+  for (int k = 0; k < kKeyframes; ++k) {
+    Matrix6d covariance = 1e-6 * Matrix6d::Identity();
+    if (k == kDegenerate) covariance.diagonal() << 5e7, 3e9, 4e8, 2e9, 3e7, 1e7;
+    closer.keyframeFinal(uint32_t(k + 1), pose_at(k), covariance, true, 0);
+  }
+  closer.finalOptimise();
+  EXPECT_EQ(closer.stats().edge_covariances_refused, 1u);
+  // The first node is the gauge (its record is the true pose here), so the re-chained final
+  // poses are the true ones.
+  for (int k = 0; k < kKeyframes; ++k) {
+    Eigen::Isometry3d T_graph;
+    ASSERT_TRUE(closer.pose(uint32_t(k + 1), &T_graph));
+    EXPECT_LT((T_graph.translation() - pose_at(k).translation()).norm(), 1e-6) << "keyframe " << k + 1;
+  }
+}
+
 TEST(LoopCloser, ARevisitAtTheAgeBoundIsConsistentAtOnce) {
   const Scene scene = cylinderScene(22, 6000, 3.5);
   const int per_lap = loop::LoopCloserOptions{}.min_age_keyframes;
