@@ -35,6 +35,16 @@ Matrix6d inverseSpd(const Matrix6d& m) {
   return ldlt.solve(Matrix6d::Identity());
 }
 
+// True when the largest translation and rotation sigmas of a [rho phi] covariance are within the
+// bounds (the loop certainty gate, the odometry-edge sanity bound).
+bool sigmasWithin(const Matrix6d& covariance, double max_translation_sigma, double max_rotation_sigma) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> t(covariance.topLeftCorner<3, 3>(), Eigen::EigenvaluesOnly);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> r(covariance.bottomRightCorner<3, 3>(), Eigen::EigenvaluesOnly);
+  return t.info() == Eigen::Success && r.info() == Eigen::Success &&
+         t.eigenvalues().maxCoeff() <= max_translation_sigma * max_translation_sigma &&
+         r.eigenvalues().maxCoeff() <= max_rotation_sigma * max_rotation_sigma;
+}
+
 bool finiteSpd(const Matrix6d& m) {
   if (!m.allFinite()) return false;
   const Eigen::LLT<Matrix6d> llt(0.5 * (m + m.transpose()));
@@ -132,10 +142,7 @@ Matrix6d LoopCloser::edgeCovariance(bool new_segment, const Matrix6d& covariance
     return diagonalCovariance(options_.segment_translation_sigma_m, options_.segment_rotation_sigma_rad);
   if (covariance_valid && finiteSpd(covariance)) {
     const Matrix6d symmetric = 0.5 * (covariance + covariance.transpose());
-    const double max_t = options_.max_edge_translation_sigma_m, max_r = options_.max_edge_rotation_sigma_rad;
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> t(symmetric.topLeftCorner<3, 3>(), Eigen::EigenvaluesOnly);
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> r(symmetric.bottomRightCorner<3, 3>(), Eigen::EigenvaluesOnly);
-    if (t.eigenvalues().maxCoeff() <= max_t * max_t && r.eigenvalues().maxCoeff() <= max_r * max_r) {
+    if (sigmasWithin(symmetric, options_.max_edge_translation_sigma_m, options_.max_edge_rotation_sigma_rad)) {
       return symmetric +
              diagonalCovariance(options_.odometry_floor_translation_sigma_m, options_.odometry_floor_rotation_sigma_rad);
     }
@@ -417,11 +424,7 @@ void LoopCloser::optimise() {
 }
 
 bool LoopCloser::certain(const Matrix6d& covariance) const {
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> t(covariance.topLeftCorner<3, 3>(), Eigen::EigenvaluesOnly);
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> r(covariance.bottomRightCorner<3, 3>(), Eigen::EigenvaluesOnly);
-  const double max_t = options_.max_loop_sigma_m, max_r = options_.max_loop_sigma_rad;
-  return t.info() == Eigen::Success && r.info() == Eigen::Success && t.eigenvalues().maxCoeff() <= max_t * max_t &&
-         r.eigenvalues().maxCoeff() <= max_r * max_r;
+  return sigmasWithin(covariance, options_.max_loop_sigma_m, options_.max_loop_sigma_rad);
 }
 
 bool LoopCloser::confirmNewestLoop() {
