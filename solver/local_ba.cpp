@@ -41,6 +41,7 @@ void LocalBundleAdjuster::clear() {
   num_pose_variables_ = 0;
   num_fixed_landmarks_ = 0;
   covariance_valid_ = false;
+  linearized_at_estimate_ = false;
 }
 
 int LocalBundleAdjuster::addKeyframe(const Eigen::Isometry3d& T_cam_world, bool fixed) {
@@ -51,6 +52,7 @@ int LocalBundleAdjuster::addKeyframe(const Eigen::Isometry3d& T_cam_world, bool 
   kf.variable = fixed ? -1 : num_pose_variables_;
   if (!fixed) variable_keyframe_[num_pose_variables_++] = num_keyframes_;
   covariance_valid_ = false;
+  linearized_at_estimate_ = false;
   return num_keyframes_++;
 }
 
@@ -60,6 +62,7 @@ int LocalBundleAdjuster::addLandmark(const Eigen::Vector3d& P_world) {
   lm.P_world = P_world;
   lm.step.setZero();
   lm.eliminated = false;
+  linearized_at_estimate_ = false;
   return num_landmarks_++;
 }
 
@@ -78,6 +81,7 @@ int LocalBundleAdjuster::addObservation(int keyframe, int landmark, ObservationK
   obs.valid = false;
   obs.outlier = false;
   obs.chi2 = 0.0;
+  linearized_at_estimate_ = false;
   return num_observations_++;
 }
 
@@ -102,7 +106,9 @@ int LocalBundleAdjuster::addLineObservation(int keyframe, int landmark, const Ei
 }
 
 void LocalBundleAdjuster::setObservationEnabled(int observation, bool enabled) {
-  if (observation >= 0 && observation < num_observations_) observations_[observation].enabled = enabled;
+  if (observation < 0 || observation >= num_observations_) return;
+  observations_[observation].enabled = enabled;
+  linearized_at_estimate_ = false;
 }
 
 // Groups observation indices by landmark (counting sort into the reserved order array).

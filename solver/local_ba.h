@@ -249,6 +249,9 @@ class LocalBundleAdjuster {
   int num_pose_variables_ = 0;
   int num_fixed_landmarks_ = 0;
   bool covariance_valid_ = false;
+  // The stored linearisation (blocks, IRLS weights, valid flags) is at the current estimate and
+  // the observation set has not changed since: computeCovariance() can eliminate from it.
+  bool linearized_at_estimate_ = false;
 };
 
 }  // namespace plumb

@@ -59,6 +59,7 @@ void LocalBundleAdjuster::updateOutlierFlags(const LocalBaOptions& options, Loca
 LocalBaSummary LocalBundleAdjuster::solve(const LocalBaOptions& options) {
   LocalBaSummary summary;
   covariance_valid_ = false;
+  linearized_at_estimate_ = false;
   if (num_pose_variables_ == 0 && num_landmarks_ == 0) return summary;
   buildStructure();
   double cost = linearize(options);
@@ -66,6 +67,7 @@ LocalBaSummary LocalBundleAdjuster::solve(const LocalBaOptions& options) {
   summary.status = LocalBaStatus::kMaxIterations;
   TrustRegion region(options.initial_trust_radius, options.max_trust_radius);
   bool relinearize = false;
+  bool last_rejected = false;
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
     if (relinearize) cost = linearize(options);
     relinearize = false;
@@ -76,13 +78,22 @@ LocalBaSummary LocalBundleAdjuster::solve(const LocalBaOptions& options) {
     double new_cost = cost;
     double predicted = 0.0;
     if (step_ok) {
+      predicted = modelCostReduction(lambda);
+      // Converged before trying the step: the quadratic model, which near the optimum is what
+      // the step actually gains, promises less than function_tolerance of the cost (the same
+      // bound an accepted step's actual decrease is held to below). Not after a rejection: the
+      // grown damping, not convergence, can make that step small. The estimate stays at the
+      // linearisation point, which computeCovariance() then reuses.
+      if (!last_rejected && predicted < options.function_tolerance * cost) {
+        summary.status = LocalBaStatus::kConverged;
+        break;
+      }
       for (int i = 0; i < num_keyframes_; ++i) {
         Keyframe& kf = keyframes_[i];
         kf.T_candidate = kf.variable >= 0 ? applyLeftIncrement(kf.step, kf.T_cam_world) : kf.T_cam_world;
       }
       for (int j = 0; j < num_landmarks_; ++j) landmarks_[j].P_candidate = landmarks_[j].P_world + landmarks_[j].step;
       new_cost = candidateCost(options, &all_valid);
-      predicted = modelCostReduction(lambda);
     }
     const double actual = cost - new_cost;
     const double step_quality = TrustRegion::stepQuality(actual, predicted);
@@ -92,6 +103,7 @@ LocalBaSummary LocalBundleAdjuster::solve(const LocalBaOptions& options) {
       region.stepAccepted(step_quality);
       ++summary.successful_steps;
       relinearize = true;
+      last_rejected = false;
       const double relative_change = actual / std::max(cost, 1e-300);
       cost = new_cost;
       if (relative_change < options.function_tolerance) {
@@ -100,10 +112,12 @@ LocalBaSummary LocalBundleAdjuster::solve(const LocalBaOptions& options) {
       }
     } else {
       region.stepRejected();
+      last_rejected = true;
     }
   }
   summary.final_cost = cost;
   summary.num_fixed_landmarks = num_fixed_landmarks_;
+  linearized_at_estimate_ = !relinearize;
   updateOutlierFlags(options, &summary);
   return summary;
 }
@@ -111,13 +125,25 @@ LocalBaSummary LocalBundleAdjuster::solve(const LocalBaOptions& options) {
 bool LocalBundleAdjuster::computeStep(const LocalBaOptions& options, double lambda) {
   buildStructure();
   linearize(options);
+  linearized_at_estimate_ = true;
   return solveDamped(options, lambda);
 }
 
 bool LocalBundleAdjuster::computeCovariance(const LocalBaOptions& options) {
   covariance_valid_ = false;
   buildStructure();
-  linearize(options);
+  if (linearized_at_estimate_) {
+    // solve() ended at its last linearisation point (converged before a step, or the last step
+    // rejected): the stored blocks are this linearisation. Its flags as linearize() leaves them:
+    // an enabled observation is an outlier exactly when it was not linearised.
+    for (int k = 0; k < num_observations_; ++k) {
+      Observation& obs = observations_[k];
+      if (obs.enabled) obs.outlier = !obs.valid;
+    }
+  } else {
+    linearize(options);
+    linearized_at_estimate_ = true;
+  }
   // lambda = 0: the undamped reduced system S = H_A - H_B H_C^-1 H_B^T, factorised in place.
   if (!solveDamped(options, 0.0)) return false;
   const Eigen::Index dim = 6 * static_cast<Eigen::Index>(num_pose_variables_);

@@ -48,6 +48,11 @@ class PoseNormalAccumulator {
     rr_[3] += u(4) * v(4), rr_[4] += u(4) * v(5), rr_[5] += u(5) * v(5);
     for (int i = 0; i < 6; ++i) g_[i] += g(i);
   }
+  // Adds (sign 1) or removes (sign -1) another accumulator's sums.
+  void merge(const PoseNormalAccumulator& other, double sign) {
+    for (int i = 0; i < 6; ++i) tt_[i] += sign * other.tt_[i], rr_[i] += sign * other.rr_[i], g_[i] += sign * other.g_[i];
+    for (int i = 0; i < 9; ++i) tr_[i] += sign * other.tr_[i];
+  }
   void finish(Matrix6d* H, Vector6d* g) const {
     *H << tt_[0], tt_[1], tt_[2], tr_[0], tr_[1], tr_[2],  //
         tt_[1], tt_[3], tt_[4], tr_[3], tr_[4], tr_[5],    //

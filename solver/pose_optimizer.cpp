@@ -63,63 +63,79 @@ double robustCost(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_cam
   return cost;
 }
 
+// One point observation's IRLS blocks at T_cam_world into `accumulator` (and, with `map`, its
+// information scaled by map_share into `map`); returns 0.5 rho, or -1 when it is behind the camera.
+// Always inlined: a call per observation would cost more than the linearisations saved below.
+__attribute__((always_inline)) inline double accumulatePoint(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_cam_world,
+                              const PosePointObservation& obs, const Kernels& kernels,
+                              PoseNormalAccumulator* accumulator, PoseNormalAccumulator* map) {
+  const Eigen::Vector3d P_cam = T_cam_world * obs.P_world;
+  if (!(P_cam.z() > kFactorMinDepth)) return -1.0;
+  Eigen::Matrix3d M;
+  Eigen::Vector3d q;
+  double rho = 0.0, weight = 0.0;
+  if (obs.has_depth) {
+    Eigen::Vector3d e;
+    Eigen::Matrix3d J_cam;
+    stereoResidualAt(camera, P_cam, obs.z, &e, &J_cam);
+    const Eigen::Vector3d omega_e = obs.information * e;
+    robustCostAndWeight(kernels.stereo, e.dot(omega_e), &rho, &weight);
+    stereoPointSpaceBlocks(J_cam, obs.information, omega_e, weight, &M, &q);
+  } else {
+    Eigen::Vector2d e;
+    Matrix23d J_cam;
+    monoResidualAt(camera, P_cam, obs.z.head<2>(), &e, &J_cam);
+    const Eigen::Matrix2d omega = obs.information.topLeftCorner<2, 2>();
+    robustCostAndWeight(kernels.mono, e.dot(omega * e), &rho, &weight);
+    pointSpaceBlocks<2>(J_cam, weight * omega, e, &M, &q);
+  }
+  accumulator->add(M, q, P_cam);
+  if (map != nullptr && obs.map_share > 0) map->add(obs.map_share * M, Eigen::Vector3d::Zero(), P_cam);
+  return 0.5 * rho;
+}
+
+// The same for a line sample.
+__attribute__((always_inline)) inline double accumulateLine(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_cam_world,
+                             const PoseLineObservation& obs, const Kernels& kernels,
+                             PoseNormalAccumulator* accumulator, PoseNormalAccumulator* map) {
+  const Eigen::Vector3d P_cam = T_cam_world * obs.P_world;
+  if (!(P_cam.z() > kFactorMinDepth)) return -1.0;
+  double e = 0.0;
+  Eigen::RowVector3d J_cam;
+  lineResidualAt(camera, P_cam, obs.line, &e, &J_cam);
+  double rho = 0.0, weight = 0.0;
+  robustCostAndWeight(kernels.line, e * e * obs.information, &rho, &weight);
+  // Rank one: A^T M A = u (A^T j)^T with j = J_cam^T, u = w Omega A^T j.
+  const Eigen::Vector3d j = J_cam.transpose();
+  Vector6d A_t_j;
+  A_t_j << j, P_cam.cross(j);
+  const Vector6d u = (weight * obs.information) * A_t_j;
+  accumulator->addRankOne(u, A_t_j, e * u);
+  if (map != nullptr && obs.map_share > 0) map->addRankOne(obs.map_share * u, A_t_j, Vector6d::Zero());
+  return 0.5 * rho;
+}
+
 // IRLS normal equations of the inliers at T_cam_world; with H_map, also the information blocks
 // scaled by each observation's map_share (summed, not inverted: the map-error term of the top).
+// With `sums`, the accumulated sums are also returned unfinished (for updateForNewInliers).
 NormalEquations linearize(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_cam_world,
                           const PosePointObservation* points, int num_points, const PoseLineObservation* lines,
                           int num_lines, const Kernels& kernels, const bool* point_inliers,
-                          const bool* line_inliers, Matrix6d* H_map = nullptr) {
+                          const bool* line_inliers, Matrix6d* H_map = nullptr,
+                          PoseNormalAccumulator* sums = nullptr) {
   NormalEquations ne;
   PoseNormalAccumulator accumulator, map_accumulator;
+  PoseNormalAccumulator* map = H_map != nullptr ? &map_accumulator : nullptr;
   for (int i = 0; i < num_points; ++i) {
     if (!point_inliers[i]) continue;
-    const PosePointObservation& obs = points[i];
-    const Eigen::Vector3d P_cam = T_cam_world * obs.P_world;
-    if (!(P_cam.z() > kFactorMinDepth)) continue;
-    Eigen::Matrix3d M;
-    Eigen::Vector3d q;
-    if (obs.has_depth) {
-      Eigen::Vector3d e;
-      Eigen::Matrix3d J_cam;
-      stereoResidualAt(camera, P_cam, obs.z, &e, &J_cam);
-      const Eigen::Vector3d omega_e = obs.information * e;
-      double rho = 0.0, weight = 0.0;
-      robustCostAndWeight(kernels.stereo, e.dot(omega_e), &rho, &weight);
-      stereoPointSpaceBlocks(J_cam, obs.information, omega_e, weight, &M, &q);
-      ne.cost += 0.5 * rho;
-    } else {
-      Eigen::Vector2d e;
-      Matrix23d J_cam;
-      monoResidualAt(camera, P_cam, obs.z.head<2>(), &e, &J_cam);
-      const Eigen::Matrix2d omega = obs.information.topLeftCorner<2, 2>();
-      double rho = 0.0, weight = 0.0;
-      robustCostAndWeight(kernels.mono, e.dot(omega * e), &rho, &weight);
-      pointSpaceBlocks<2>(J_cam, weight * omega, e, &M, &q);
-      ne.cost += 0.5 * rho;
-    }
-    accumulator.add(M, q, P_cam);
-    if (H_map != nullptr && obs.map_share > 0) map_accumulator.add(obs.map_share * M, Eigen::Vector3d::Zero(), P_cam);
+    ne.cost += std::max(0.0, accumulatePoint(camera, T_cam_world, points[i], kernels, &accumulator, map));
   }
   for (int i = 0; i < num_lines; ++i) {
     if (!line_inliers[i]) continue;
-    const PoseLineObservation& obs = lines[i];
-    const Eigen::Vector3d P_cam = T_cam_world * obs.P_world;
-    if (!(P_cam.z() > kFactorMinDepth)) continue;
-    double e = 0.0;
-    Eigen::RowVector3d J_cam;
-    lineResidualAt(camera, P_cam, obs.line, &e, &J_cam);
-    double rho = 0.0, weight = 0.0;
-    robustCostAndWeight(kernels.line, e * e * obs.information, &rho, &weight);
-    // Rank one: A^T M A = u (A^T j)^T with j = J_cam^T, u = w Omega A^T j.
-    const Eigen::Vector3d j = J_cam.transpose();
-    Vector6d A_t_j;
-    A_t_j << j, P_cam.cross(j);
-    const Vector6d u = (weight * obs.information) * A_t_j;
-    accumulator.addRankOne(u, A_t_j, e * u);
-    if (H_map != nullptr && obs.map_share > 0) map_accumulator.addRankOne(obs.map_share * u, A_t_j, Vector6d::Zero());
-    ne.cost += 0.5 * rho;
+    ne.cost += std::max(0.0, accumulateLine(camera, T_cam_world, lines[i], kernels, &accumulator, map));
   }
   accumulator.finish(&ne.H, &ne.g);
+  if (sums != nullptr) *sums = accumulator;
   if (H_map != nullptr) {
     Vector6d unused;
     map_accumulator.finish(H_map, &unused);
@@ -127,11 +143,20 @@ NormalEquations linearize(const CameraIntrinsics& camera, const Eigen::Isometry3
   return ne;
 }
 
+// The flags a classification changed, as normal-equation sums at the last linearisation's pose
+// T_linearized: `added` for observations that became inliers, `removed` for those that stopped.
+struct InlierChange {
+  Eigen::Isometry3d T_linearized = Eigen::Isometry3d::Identity();
+  PoseNormalAccumulator added, removed;
+  int changed = 0;
+};
+
 // Re-classifies every observation and fills the inlier counts; returns how many flags changed.
+// With `change`, the normal-equation sums of the changed observations at change->T_linearized.
 int classify(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_cam_world,
               const PosePointObservation* points, int num_points, const PoseLineObservation* lines,
-              int num_lines, const PoseOptimizerOptions& options, bool* point_inliers, bool* line_inliers,
-              PoseResult* result) {
+              int num_lines, const PoseOptimizerOptions& options, const Kernels& kernels, bool* point_inliers,
+              bool* line_inliers, PoseResult* result, InlierChange* change) {
   result->num_point_inliers = 0;
   result->num_line_inliers = 0;
   result->inlier_chi2 = InlierChi2Sums{};
@@ -140,18 +165,31 @@ int classify(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_cam_worl
   for (int i = 0; i < num_points; ++i) {
     const double threshold = points[i].has_depth ? options.chi2.stereo : options.chi2.mono;
     const bool inlier = pointChi2(camera, T_cam_world, points[i], &chi2) && chi2 <= threshold;
-    changed += inlier != point_inliers[i] ? 1 : 0;
+    if (inlier != point_inliers[i]) {
+      ++changed;
+      if (change != nullptr) {
+        (void)accumulatePoint(camera, change->T_linearized, points[i], kernels,
+                              inlier ? &change->added : &change->removed, nullptr);
+      }
+    }
     point_inliers[i] = inlier;
     result->num_point_inliers += inlier ? 1 : 0;
     if (inlier) result->inlier_chi2.add(points[i].has_depth ? 3 : 2, chi2);
   }
   for (int i = 0; i < num_lines; ++i) {
     const bool inlier = lineChi2(camera, T_cam_world, lines[i], &chi2) && chi2 <= options.chi2.line;
-    changed += inlier != line_inliers[i] ? 1 : 0;
+    if (inlier != line_inliers[i]) {
+      ++changed;
+      if (change != nullptr) {
+        (void)accumulateLine(camera, change->T_linearized, lines[i], kernels,
+                             inlier ? &change->added : &change->removed, nullptr);
+      }
+    }
     line_inliers[i] = inlier;
     result->num_line_inliers += inlier ? 1 : 0;
     if (inlier) result->inlier_chi2.add(1, chi2);
   }
+  if (change != nullptr) change->changed = changed;
   return changed;
 }
 
@@ -181,11 +219,34 @@ PoseResult optimizePose(const CameraIntrinsics& camera, const Eigen::Isometry3d&
   for (int i = 0; i < num_points; ++i) point_inliers[i] = true;
   for (int i = 0; i < num_lines; ++i) line_inliers[i] = true;
 
+  // A round ends converged when its last step was below step_tolerance: its last linearisation,
+  // at T_linearized, is then within the tolerance of the final pose. The next round starts from
+  // those sums with only the observations whose flags changed added or removed (at T_linearized,
+  // the same point as the rest), instead of linearising every observation again: the two differ
+  // by less than a step the tolerance calls converged.
+  PoseNormalAccumulator sums;
+  InlierChange change;
+  bool reuse = false;
+  double last_cost = 0.0;
   for (int round = 0; round < options.rounds; ++round) {
     double lambda = options.initial_lambda;
+    bool converged = false;
     for (int it = 0; it < options.iterations_per_round; ++it) {
-      const NormalEquations ne = linearize(camera, result.T_cam_world, points, num_points, lines, num_lines,
-                                           kernels, point_inliers, line_inliers);
+      NormalEquations ne;
+      Eigen::Isometry3d T_linearized = result.T_cam_world;
+      if (reuse) {
+        sums.merge(change.added, 1.0);
+        sums.merge(change.removed, -1.0);
+        sums.finish(&ne.H, &ne.g);
+        ne.cost = last_cost;  // not read after the first round
+        T_linearized = change.T_linearized;
+        reuse = false;
+      } else {
+        ne = linearize(camera, result.T_cam_world, points, num_points, lines, num_lines, kernels, point_inliers,
+                       line_inliers, nullptr, &sums);
+      }
+      last_cost = ne.cost;
+      change.T_linearized = T_linearized;
       // The first linearisation sees every observation at the initial pose: that is the initial cost.
       if (result.iterations == 0 && round == 0 && it == 0) result.initial_cost = ne.cost;
       Matrix6d H_damped = ne.H;
@@ -195,23 +256,31 @@ PoseResult optimizePose(const CameraIntrinsics& camera, const Eigen::Isometry3d&
       const Vector6d delta = -ldlt.solve(ne.g);
       if (!delta.allFinite()) break;
       ++result.iterations;
-      const Eigen::Isometry3d T_candidate = applyLeftIncrement(delta, result.T_cam_world);
+      const Eigen::Isometry3d T_candidate = applyLeftIncrement(delta, T_linearized);
       if (options.levenberg_marquardt) {
         const double candidate_cost = robustCost(camera, T_candidate, points, num_points, lines, num_lines,
                                                  kernels, point_inliers, line_inliers);
         if (!(candidate_cost < ne.cost)) {
           lambda *= 10.0;
+          result.T_cam_world = T_linearized;
+          reuse = false;
           continue;
         }
         lambda = std::max(lambda * 0.1, 1e-12);
       }
       result.T_cam_world = T_candidate;
-      if (delta.norm() < options.step_tolerance) break;
+      if (delta.norm() < options.step_tolerance) {
+        converged = true;
+        break;
+      }
     }
-    const int changed = classify(camera, result.T_cam_world, points, num_points, lines, num_lines, options,
-                                 point_inliers, line_inliers, &result);
+    change.added = PoseNormalAccumulator();
+    change.removed = PoseNormalAccumulator();
+    const int changed = classify(camera, result.T_cam_world, points, num_points, lines, num_lines, options, kernels,
+                                 point_inliers, line_inliers, &result, converged ? &change : nullptr);
     // Same inlier set as this round optimised: further rounds would repeat it exactly.
     if (changed == 0) break;
+    reuse = converged;
   }
 
   if (!options.compute_covariance) return result;
