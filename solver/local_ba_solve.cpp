@@ -67,7 +67,6 @@ LocalBaSummary LocalBundleAdjuster::solve(const LocalBaOptions& options) {
   summary.status = LocalBaStatus::kMaxIterations;
   TrustRegion region(options.initial_trust_radius, options.max_trust_radius);
   bool relinearize = false;
-  bool last_rejected = false;
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
     if (relinearize) cost = linearize(options);
     relinearize = false;
@@ -78,22 +77,13 @@ LocalBaSummary LocalBundleAdjuster::solve(const LocalBaOptions& options) {
     double new_cost = cost;
     double predicted = 0.0;
     if (step_ok) {
-      predicted = modelCostReduction(lambda);
-      // Converged before trying the step: the quadratic model, which near the optimum is what
-      // the step actually gains, promises less than function_tolerance of the cost (the same
-      // bound an accepted step's actual decrease is held to below). Not after a rejection: the
-      // grown damping, not convergence, can make that step small. The estimate stays at the
-      // linearisation point, which computeCovariance() then reuses.
-      if (!last_rejected && predicted < options.function_tolerance * cost) {
-        summary.status = LocalBaStatus::kConverged;
-        break;
-      }
       for (int i = 0; i < num_keyframes_; ++i) {
         Keyframe& kf = keyframes_[i];
         kf.T_candidate = kf.variable >= 0 ? applyLeftIncrement(kf.step, kf.T_cam_world) : kf.T_cam_world;
       }
       for (int j = 0; j < num_landmarks_; ++j) landmarks_[j].P_candidate = landmarks_[j].P_world + landmarks_[j].step;
       new_cost = candidateCost(options, &all_valid);
+      predicted = modelCostReduction(lambda);
     }
     const double actual = cost - new_cost;
     const double step_quality = TrustRegion::stepQuality(actual, predicted);
@@ -103,7 +93,6 @@ LocalBaSummary LocalBundleAdjuster::solve(const LocalBaOptions& options) {
       region.stepAccepted(step_quality);
       ++summary.successful_steps;
       relinearize = true;
-      last_rejected = false;
       const double relative_change = actual / std::max(cost, 1e-300);
       cost = new_cost;
       if (relative_change < options.function_tolerance) {
@@ -112,7 +101,6 @@ LocalBaSummary LocalBundleAdjuster::solve(const LocalBaOptions& options) {
       }
     } else {
       region.stepRejected();
-      last_rejected = true;
     }
   }
   summary.final_cost = cost;
@@ -133,8 +121,8 @@ bool LocalBundleAdjuster::computeCovariance(const LocalBaOptions& options) {
   covariance_valid_ = false;
   buildStructure();
   if (linearized_at_estimate_) {
-    // solve() ended at its last linearisation point (converged before a step, or the last step
-    // rejected): the stored blocks are this linearisation. Its flags as linearize() leaves them:
+    // solve() ended at its last linearisation point (its last step was rejected, or it ran no
+    // step): the stored blocks are this linearisation. Its flags as linearize() leaves them:
     // an enabled observation is an outlier exactly when it was not linearised.
     for (int k = 0; k < num_observations_; ++k) {
       Observation& obs = observations_[k];
