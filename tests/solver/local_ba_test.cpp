@@ -82,6 +82,31 @@ TEST(LocalBa, FlagsOutliersForCulling) {
   expectRecovered(w, ba, 3e-3, 1e-2);
 }
 
+// computeCovariance() eliminates from the stored linearisation when solve() ended at its point
+// (here: no iteration run) and linearises again otherwise (here: forced by re-enabling an
+// observation): both must give the same covariance and the same flags, bit for bit.
+TEST(LocalBa, CovarianceReusesTheLinearisationAtTheEstimateExactly) {
+  SyntheticWindowConfig config;
+  config.seed = 11;
+  config.outlier_fraction = 0.05;
+  const SyntheticWindow w = makeSyntheticWindow(config);
+  LocalBundleAdjuster reused, fresh;
+  loadWindow(w, /*initial=*/true, &reused);
+  loadWindow(w, /*initial=*/true, &fresh);
+  LocalBaOptions options;
+  options.max_iterations = 0;  // solve() only linearises: the estimate is the linearisation point
+  ASSERT_TRUE(reused.solve(options).ok());
+  ASSERT_TRUE(fresh.solve(options).ok());
+  fresh.setObservationEnabled(0, true);  // no change to the problem, but the reuse is off
+  ASSERT_TRUE(reused.computeCovariance(options));
+  ASSERT_TRUE(fresh.computeCovariance(options));
+  ASSERT_EQ(reused.numPoseVariables(), fresh.numPoseVariables());
+  ASSERT_GT(reused.numPoseVariables(), 0);
+  EXPECT_TRUE(reused.fullCovariance().isApprox(fresh.fullCovariance(), 0.0));
+  EXPECT_GT(reused.fullCovariance().norm(), 0.0);
+  for (int k = 0; k < reused.numObservations(); ++k) ASSERT_EQ(reused.isOutlier(k), fresh.isOutlier(k)) << k;
+}
+
 // Single observations (stereo, mono, line), a landmark without observations, landmarks at a
 // camera centre: nothing may become NaN, and the rest of the window still solves.
 TEST(LocalBa, DegenerateLandmarksNeverProduceNaN) {
