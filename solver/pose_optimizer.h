@@ -9,7 +9,10 @@
 // re-classified by its chi-square value against the threshold of its dimension (3 dof stereo
 // points, 2 dof mono points, 1 dof line samples), so a wrongly rejected match can come back.
 // A round stops early once the step is below `step_tolerance`, and the rounds stop early once a
-// classification leaves every flag unchanged (the next round would repeat the last one).
+// classification leaves every flag unchanged (the next round would repeat the last one). A round
+// after a converged one starts from the last linearisation with only the re-classified
+// observations added or removed (at that linearisation's pose, within the tolerance of the
+// round's end), not from a new linearisation of every observation.
 //
 // Covariance: at the solution, the inverse of H = sum_inliers J_i^T (w_i Omega_i) J_i (w_i the
 // IRLS weight rho'(s_i)), the 6x6 covariance of the left perturbation delta = [rho; phi] of
