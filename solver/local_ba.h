@@ -169,7 +169,8 @@ class LocalBundleAdjuster {
   // A posteriori variance factor sigma0^2 (solver/variance_factor.h) of the inliers after solve():
   // redundancy = inlier error dof - 6 per optimised pose - per landmark min(its inlier error dof,
   // 3 for a point, 2 for a line sample: its slide along the line is unobservable).
-  // Read it before computeCovariance(), which re-evaluates the chi2 values. local_ba_variance.cpp.
+  // Read it before computeCovariance(), which may re-linearise (and so re-evaluate the chi2 values
+  // and reset the outlier flags; docs/SOLVER.md). local_ba_variance.cpp.
   double varianceFactor(const LocalBaOptions& options) const;
 
   // Diagnostics (tests): linearise at the current estimate and solve ONE damped step with the
