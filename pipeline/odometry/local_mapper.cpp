@@ -60,7 +60,13 @@ InsertResult LocalMapper::insertKeyframe(const KeyframeRequest& request) {
 
 InsertResult LocalMapper::addKeyframe(const KeyframeRequest& request, LocalMap* fresh) {
   InsertResult result = addUnrefined(request);
-  if (result.inserted) buildSnapshot(unrefined_slot_, fresh);
+  if (!result.inserted) return result;
+  // The landmarks the tracker's counts (applyVisibility) already condemn leave before the fresh
+  // map is made, not only after the BA (ORB-SLAM culls before its local BA too): frames tracked
+  // against the fresh map then do not match them. Measured on head250 over six start frames at
+  // M = 1: mean ATE +6.5 % over the unsplit update instead of +9 % without this cull.
+  if (!unrefined_new_map_) cullLandmarks(result.keyframe_id);
+  buildSnapshot(unrefined_slot_, fresh);
   return result;
 }
 

@@ -68,14 +68,14 @@ class LocalMapper {
 
   // Steps 1-5 above in one call: one snapshot, after local BA.
   InsertResult insertKeyframe(const KeyframeRequest& request);
-  // The same work in two halves (docs/RUNTIME.md "Map updates at a fixed lag"): addKeyframe() does
-  // steps 1-2 (the keyframe at its tracked pose, its new landmarks at their measured positions)
-  // and writes that "fresh" snapshot into *fresh (a new version; localMap() is not changed yet);
-  // refineKeyframe() does steps 3-5 for the keyframe addKeyframe() just inserted (local BA,
-  // culling) and publishes the refined snapshot as localMap(). The two halves leave the map and
-  // localMap() exactly as insertKeyframe() does. refineKeyframe() returns whether it refined
-  // anything: false after a failed insertion (nothing published) and after a new map (no BA there:
-  // localMap() is published, with the fresh snapshot's content).
+  // The same work in two halves (split map updates, docs/RUNTIME.md "Map updates at a fixed lag"):
+  // addKeyframe() does steps 1-2 (the keyframe at its tracked pose, its new landmarks at their
+  // measured positions) and step 4 (culling), and writes that "fresh" snapshot into *fresh (a new
+  // version; localMap() is not changed yet); refineKeyframe() does steps 3-5 for the keyframe
+  // addKeyframe() just inserted (local BA, culling again) and publishes the refined snapshot as
+  // localMap(). It returns whether it refined anything: false after a failed insertion (nothing
+  // published) and after a new map (no BA there: localMap() is published, with the fresh
+  // snapshot's content).
   InsertResult addKeyframe(const KeyframeRequest& request, LocalMap* fresh);
   bool refineKeyframe(InsertResult* result);
   // Loop closing's correction (pipeline/odometry/map_correction.h): ONE rigid motion
