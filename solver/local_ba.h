@@ -67,6 +67,7 @@
 #include "solver/camera_intrinsics.h"
 #include "solver/robust_kernel.h"
 #include "solver/types.h"
+#include "solver/variance_factor.h"
 #include "solver/zero_page_allocator.h"
 
 namespace plumb {
@@ -101,6 +102,22 @@ struct LocalBaOptions {
            : kind == ObservationKind::kMonoPoint ? chi2.mono
                                                  : chi2.line;
   }
+};
+
+// Scales on the model's information by residual kind, for computeCovariance(): the reciprocals of
+// the variance components the residuals support (LocalBundleAdjuster::varianceComponents).
+struct InformationScales {
+  double pixel = 1.0;  // points' [u, v] (stereo and mono)
+  double depth = 1.0;  // stereo points' disparity u - u_r
+  double line = 1.0;   // line samples' distance to the 2D line
+};
+
+// A posteriori variance components of the points' two noise sources (solver/variance_factor.h):
+// pixel detection and depth, each the model's noise times its own factor.
+struct PointVarianceComponents {
+  double pixel = 1.0;
+  double depth = 1.0;
+  double redundancy = 0.0;  // of the point residuals, shared by the two in proportion to their dof
 };
 
 enum class LocalBaStatus {
@@ -152,7 +169,9 @@ class LocalBundleAdjuster {
 
   // Linearise at the current estimate (undamped) and compute C = S^-1. Returns false when S is
   // not positive definite (e.g. no fixed keyframe, or a keyframe without constraints).
-  bool computeCovariance(const LocalBaOptions& options);
+  // `scales` multiply the information of each residual kind in that linearisation only (the
+  // variance components of docs/UNCERTAINTY.md; the solution is not touched).
+  bool computeCovariance(const LocalBaOptions& options, const InformationScales& scales = InformationScales());
   Matrix6d covariance(int keyframe) const;  // zero for fixed keyframes
   Eigen::Block<const Eigen::MatrixXd> fullCovariance() const;
   int numPoseVariables() const { return num_pose_variables_; }
@@ -171,6 +190,15 @@ class LocalBundleAdjuster {
   // 3 for a point, 2 for a line sample: its slide along the line is unobservable).
   // Read it before computeCovariance(), which re-evaluates the chi2 values. local_ba_variance.cpp.
   double varianceFactor(const LocalBaOptions& options) const;
+  // Variance components of the POINT residuals after solve() (before computeCovariance(), like
+  // varianceFactor): the stereo residual [u, v, u_r] is split into its pixel part [u, v] and its
+  // depth part, the disparity u - u_r, in which the model's information is block diagonal (the
+  // two are independent sensors: corner detection and the depth camera), and each part's inlier
+  // chi2 is divided by its share of the points' redundancy (error dof - 6 per optimised pose - 3
+  // per point landmark, shared in proportion to the parts' dof: a point seen V times has 2V - 2
+  // pixel and V - 1 depth redundancy). Line samples are left out: see docs/UNCERTAINTY.md (their
+  // residuals cannot show their noise). A part whose redundancy is below min_redundancy gets 1.
+  PointVarianceComponents varianceComponents(const LocalBaOptions& options, int min_redundancy = 30) const;
 
   // Diagnostics (tests): linearise at the current estimate and solve ONE damped step with the
   // given lambda, without applying it. Returns false if the damped S is not positive definite.
@@ -249,6 +277,7 @@ class LocalBundleAdjuster {
   int num_pose_variables_ = 0;
   int num_fixed_landmarks_ = 0;
   bool covariance_valid_ = false;
+  InformationScales information_scales_;  // computeCovariance's; all 1 while solving
 };
 
 }  // namespace plumb

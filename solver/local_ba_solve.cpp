@@ -114,10 +114,12 @@ bool LocalBundleAdjuster::computeStep(const LocalBaOptions& options, double lamb
   return solveDamped(options, lambda);
 }
 
-bool LocalBundleAdjuster::computeCovariance(const LocalBaOptions& options) {
+bool LocalBundleAdjuster::computeCovariance(const LocalBaOptions& options, const InformationScales& scales) {
   covariance_valid_ = false;
   buildStructure();
+  information_scales_ = scales;
   linearize(options);
+  information_scales_ = InformationScales();
   // lambda = 0: the undamped reduced system S = H_A - H_B H_C^-1 H_B^T, factorised in place.
   if (!solveDamped(options, 0.0)) return false;
   const Eigen::Index dim = 6 * static_cast<Eigen::Index>(num_pose_variables_);
