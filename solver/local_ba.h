@@ -91,6 +91,17 @@ struct LocalBaOptions {
   // Eigenvalues of a 3x3 landmark block below this fraction of its largest one are treated as
   // exact zeros (pseudo-inverse; see DEGENERATE LANDMARKS above).
   double landmark_singular_threshold = 1e-10;
+  // computeCovariance() refuses the covariance when, for some pose variable k, C_kk * H_kk exceeds
+  // this: H_kk is the variable's own information (everything else known), 1 / C_kk its marginal
+  // information (landmarks and other poses eliminated), so the product says how much of the
+  // information the elimination cancelled (a variance inflation factor, independent of units).
+  // The cancellation is computed in floating point with an error of ~1e-13 of H_kk: a direction
+  // the observations do not fix leaves a pivot of that size and EITHER sign. Measured: genuine
+  // windows reach 2.8e7 (synth:office_loop:1 with noise; head250 2.7e6), a window with a null
+  // direction 5e13 (synth:fast_rotation:1 noise-free, where the sign came out positive and one
+  // keyframe published 1e7-3e9 m^2/rad^2 against 1e-7 for its neighbours). At 1e9 a marginal is
+  // still ~1e4 times its rounding error. docs/UNCERTAINTY.md "A degenerate window".
+  double covariance_max_variance_inflation = 1e9;
 
   RobustKernel kernelFor(ObservationKind kind) const {
     return {kernel, kind == ObservationKind::kStereoPoint ? kernel_delta_stereo
@@ -168,7 +179,8 @@ class LocalBundleAdjuster {
   LocalBaSummary solve(const LocalBaOptions& options);
 
   // Linearise at the current estimate (undamped) and compute C = S^-1. Returns false when S is
-  // not positive definite (e.g. no fixed keyframe, or a keyframe without constraints).
+  // not positive definite (e.g. no fixed keyframe, or a keyframe without constraints), or
+  // numerically singular (options.covariance_max_variance_inflation).
   // `scales` multiply the information of each residual kind in that linearisation only (the
   // variance components of docs/UNCERTAINTY.md; the solution is not touched).
   bool computeCovariance(const LocalBaOptions& options, const InformationScales& scales = InformationScales());

@@ -124,8 +124,20 @@ bool LocalBundleAdjuster::computeCovariance(const LocalBaOptions& options, const
   if (!solveDamped(options, 0.0)) return false;
   const Eigen::Index dim = 6 * static_cast<Eigen::Index>(num_pose_variables_);
   choleskyInverse(S_.topLeftCorner(dim, dim), covariance_.topLeftCorner(dim, dim));
-  covariance_valid_ = covariance_.topLeftCorner(dim, dim).allFinite();
-  return covariance_valid_;
+  if (!covariance_.topLeftCorner(dim, dim).allFinite()) return false;
+  // A direction the observations do not fix survives the factorisation as a pivot of rounding
+  // size and either sign: refuse it when a variable's marginal information 1 / C_kk is not well
+  // above the rounding error of the terms it was computed from (its own information H_kk).
+  for (int v = 0; v < num_pose_variables_; ++v) {
+    const Matrix6d& H = keyframes_[variable_keyframe_[v]].H_pose;
+    for (int d = 0; d < 6; ++d) {
+      const Eigen::Index k = 6 * v + d;
+      const double inflation = covariance_(k, k) * H(d, d);
+      if (!(inflation <= options.covariance_max_variance_inflation)) return false;
+    }
+  }
+  covariance_valid_ = true;
+  return true;
 }
 
 }  // namespace plumb

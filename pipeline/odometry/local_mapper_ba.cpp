@@ -230,6 +230,7 @@ void LocalMapper::runLocalBa(int kf_slot, InsertResult* result) {
     variance_factor = ba_.varianceFactor(ba_options_);
   }
   const bool have_covariance = ba_.computeCovariance(ba_options_, scales);
+  if (!have_covariance) ++stats_.ba_covariances_refused;  // singular: the keyframes keep the last BA's
   for (int slot : window) {
     Keyframe& kf = map_.keyframe(slot);
     const int index = s_->ba_keyframe_index[slot];
@@ -239,8 +240,11 @@ void LocalMapper::runLocalBa(int kf_slot, InsertResult* result) {
     if (have_covariance) {
       // Calibrated like the relative covariances (docs/UNCERTAINTY.md); its gauge is this BA's
       // fixed keyframes.
-      kf.covariance = variance_factor * u.relative_scale * ba_.covariance(index);
-      kf.covariance_valid = true;
+      const Matrix6d covariance = variance_factor * u.relative_scale * ba_.covariance(index);
+      if (publishable(covariance)) {
+        kf.covariance = covariance;
+        kf.covariance_valid = true;
+      }
     }
   }
   moveSingleViewLandmarks();

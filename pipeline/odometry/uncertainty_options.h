@@ -86,6 +86,14 @@ struct UncertaintyOptions {
   // Relative covariance used for chaining when local BA gave none (the loop closer's default).
   double default_translation_sigma_m = 0.02;
   double default_rotation_sigma_rad = 0.01;
+  // Physical bounds on a keyframe covariance local BA publishes (its marginal, whose gauge is the
+  // window's fixed keyframes a few keyframes away, and the relative pose to its previous keyframe):
+  // a keyframe the tracker placed is never that uncertain against its neighbours (1 m, 29 deg), so
+  // a larger one is a numerical failure, not a measurement. Refused (the last BA's value is kept,
+  // counted as ba_covariances_refused in --stats). The loop closer's odometry-edge bound is the
+  // same (LoopCloserOptions::max_edge_*).
+  double max_published_translation_sigma_m = 1.0;
+  double max_published_rotation_sigma_rad = 0.5;
   // World covariance of the first keyframe of a later map segment (started at the last known pose
   // after tracking was lost: that pose is a guess; the loop closer's weak segment edge).
   double segment_translation_sigma_m = 1.0;
