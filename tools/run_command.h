@@ -51,6 +51,7 @@ struct RunCommandOptions {
   bool no_lines = false;        // --no-lines
   bool no_loops = false;        // --no-loops
   long long output_delay = 60;  // --output-delay N
+  long long refine_lag = SystemOptions::kDefaultRefineLagFrames;  // --refine-lag M
   // reporting
   long long rss_every = 0;     // --rss-every N
   long long report_every = 0;  // --report-every N

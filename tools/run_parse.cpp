@@ -56,6 +56,11 @@ FlagTable runFlagTable(RunCommandOptions* o) {
       .toggle("synth-noise", &o->synth_noise, "synthetic scenes with Kinect-like depth and pixel noise")
       .integer("output-delay", "N", 0, 10'000, &o->output_delay,
                "frames held back so local BA refines them (default 60; 0 = as tracked)")
+      .integer("refine-lag", "M", 0, SystemOptions::kMaxRefineLagFrames, &o->refine_lag,
+               "split map updates: a keyframe's landmarks reach tracking at the next frame,\n"
+               "its local BA M frames later (fast mode overlaps tracking with the BA; the\n"
+               "same bytes in every mode but realtime); default 0 = one update after the\n"
+               "BA (docs/RUNTIME.md \"Map updates at a fixed lag\")")
       .integer("rss-every", "N", 0, kMaxFrameCount, &o->rss_every,
                "record peak RSS every N frames in the statistics (poses are then not\n"
                "kept in memory: no synthetic ATE unless --gt is given)")

@@ -41,6 +41,7 @@ Status buildOptions(const RunCommandOptions& o, const std::atomic<bool>* stop, R
   SystemOptions& system = plan->system_options;
   setLineSamples(int(o.line_samples), !o.no_lines, &system.odometry);
   system.output_delay_frames = int(o.output_delay);
+  system.refine_lag_frames = int(o.refine_lag);
   PLUMB_RETURN_IF_ERROR(validate(system));
   OdometryRunOptions& run = plan->run_options;
   runtime::RunOptions& s = run.schedule;

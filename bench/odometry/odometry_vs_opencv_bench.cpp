@@ -1,5 +1,5 @@
 // plumb_bench_odometry_vs_opencv [DATASET|synth:PRESET] [--frames N] [--repeat N] [--rt-priority P]
-//                               [--map-lag L] [--no-opencv] [--synth-noise]
+//                               [--map-lag L] [--refine-lag M] [--no-opencv] [--synth-noise]
 // The whole odometry against OpenCV's RgbdOdometry (contrib `rgbd`: dense photometric + depth
 // odometry, the stock RGB-D odometry of OpenCV), in ONE run, on the SAME frames, decoded once into
 // memory beforehand so that no PNG decoding is timed for either side:
@@ -14,7 +14,9 @@
 //      lock-step / fast wall (the threads' speed-up; target >= 1.7 on two cores), and the ATE of
 //      each trajectory when the folder has groundtruth.txt (synthetic scenes: the exact path).
 // --map-lag L sets SystemOptions::map_lag_frames (default: the system's default) to measure what
-// the fixed lag of map updates costs in accuracy and buys in fast mode's speed; --no-opencv skips (3);
+// the fixed lag of map updates costs in accuracy and buys in fast mode's speed, --refine-lag M
+// SystemOptions::refine_lag_frames (0: no split map updates; with --map-lag L > 1 it must be 0);
+// --no-opencv skips (3);
 // --synth-noise renders a synth:PRESET with Kinect-like depth and pixel noise (as `plumb run`'s).
 // --repeat N (default 3) alternates the three N times and keeps each one's fastest run: other jobs
 // on a shared machine only ever slow a run down. --rt-priority P runs them SCHED_FIFO (the lock-step
@@ -193,6 +195,8 @@ int main(int argc, char** argv) {
       rt_priority = std::atoi(argv[++i]);
     } else if (!std::strcmp(argv[i], "--map-lag") && i + 1 < argc) {
       system_options.map_lag_frames = std::atoi(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--refine-lag") && i + 1 < argc) {
+      system_options.refine_lag_frames = std::atoi(argv[++i]);
     } else if (!std::strcmp(argv[i], "--no-opencv")) {
       with_opencv = false;
     } else if (!std::strcmp(argv[i], "--synth-noise")) {
@@ -200,7 +204,7 @@ int main(int argc, char** argv) {
     } else if (argv[i][0] == '-') {
       std::fprintf(stderr,
                    "usage: plumb_bench_odometry_vs_opencv [DATASET|synth:PRESET] [--frames N] [--repeat N] "
-                   "[--rt-priority P] [--map-lag L] [--no-opencv] [--synth-noise]\n");
+                   "[--rt-priority P] [--map-lag L] [--refine-lag M] [--no-opencv] [--synth-noise]\n");
       return 2;
     } else {
       dir = argv[i];
@@ -239,8 +243,10 @@ int main(int argc, char** argv) {
   } else if (!readTumTrajectory(dir + "/groundtruth.txt", &ground_truth).ok()) {
     ground_truth.clear();
   }
-  std::printf("%s: %zu frames in memory (%dx%d); map lag %d frames; best of %d alternating runs each\n", dir.c_str(),
-              frames.size(), camera.width, camera.height, system_options.map_lag_frames, repeat);
+  check(validate(system_options));
+  std::printf("%s: %zu frames in memory (%dx%d); map lag %d frames, refine lag %d; best of %d alternating runs each\n",
+              dir.c_str(), frames.size(), camera.width, camera.height, system_options.map_lag_frames,
+              system_options.refine_lag_frames, repeat);
 
   Timing lock_step, fast, rgbd;
   std::vector<StampedPose> lock_step_poses, fast_poses, rgbd_poses;

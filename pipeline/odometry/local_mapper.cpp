@@ -53,7 +53,49 @@ void LocalMapper::retireAll() {
 }
 
 InsertResult LocalMapper::insertKeyframe(const KeyframeRequest& request) {
+  InsertResult result = addUnrefined(request);
+  (void)refineKeyframe(&result);
+  return result;
+}
+
+InsertResult LocalMapper::addKeyframe(const KeyframeRequest& request, LocalMap* fresh) {
+  InsertResult result = addUnrefined(request);
+  if (!result.inserted) return result;
+  // The landmarks the tracker's counts (applyVisibility) already condemn leave before the fresh
+  // map is made, not only after the BA (ORB-SLAM culls before its local BA too): frames tracked
+  // against the fresh map then do not match them. Measured on head250 over six start frames at
+  // M = 1: mean ATE +6.5 % over the unsplit update instead of +9 % without this cull.
+  if (!unrefined_new_map_) cullLandmarks(result.keyframe_id);
+  buildSnapshot(unrefined_slot_, fresh);
+  return result;
+}
+
+bool LocalMapper::refineKeyframe(InsertResult* result) {
+  const int kf_slot = unrefined_slot_;
+  if (kf_slot < 0) return false;
+  unrefined_slot_ = -1;
+  const bool refine = !unrefined_new_map_;  // a new map has nothing to adjust yet
+  if (refine) {
+    runLocalBa(kf_slot, result);
+    cullLandmarks(map_.keyframe(kf_slot).id);
+  }
+  recordPeakCounts();
+  publishSnapshot(kf_slot);
+  return refine;
+}
+
+void LocalMapper::recordPeakCounts() {
+  const MapCounts counts = map_.counts();
+  stats_.peak.keyframes = std::max(stats_.peak.keyframes, counts.keyframes);
+  stats_.peak.points = std::max(stats_.peak.points, counts.points);
+  stats_.peak.lines = std::max(stats_.peak.lines, counts.lines);
+  stats_.peak.point_observations = std::max(stats_.peak.point_observations, counts.point_observations);
+  stats_.peak.line_observations = std::max(stats_.peak.line_observations, counts.line_observations);
+}
+
+InsertResult LocalMapper::addUnrefined(const KeyframeRequest& request) {
   InsertResult result;
+  unrefined_slot_ = -1;
   if (request.start_new_map) {
     retireAll();
     map_.clear();
@@ -94,17 +136,8 @@ InsertResult LocalMapper::insertKeyframe(const KeyframeRequest& request) {
   }
   result.new_points = createPoints(kf_slot, request);
   result.new_lines = options_.tracker.use_lines ? createLines(kf_slot, request) : 0;
-  if (!request.start_new_map) {
-    runLocalBa(kf_slot, &result);
-    cullLandmarks(kf.id);
-  }
-  const MapCounts counts = map_.counts();
-  stats_.peak.keyframes = std::max(stats_.peak.keyframes, counts.keyframes);
-  stats_.peak.points = std::max(stats_.peak.points, counts.points);
-  stats_.peak.lines = std::max(stats_.peak.lines, counts.lines);
-  stats_.peak.point_observations = std::max(stats_.peak.point_observations, counts.point_observations);
-  stats_.peak.line_observations = std::max(stats_.peak.line_observations, counts.line_observations);
-  publishSnapshot(kf_slot);
+  unrefined_slot_ = kf_slot;
+  unrefined_new_map_ = request.start_new_map;
   return result;
 }
 

@@ -70,7 +70,18 @@ class LocalMapper {
   LocalMapper(const LocalMapper&) = delete;
   LocalMapper& operator=(const LocalMapper&) = delete;
 
+  // Steps 1-5 above in one call: one snapshot, after local BA.
   InsertResult insertKeyframe(const KeyframeRequest& request);
+  // The same work in two halves (split map updates, docs/RUNTIME.md "Map updates at a fixed lag"):
+  // addKeyframe() does steps 1-2 (the keyframe at its tracked pose, its new landmarks at their
+  // measured positions) and step 4 (culling), and writes that "fresh" snapshot into *fresh (a new
+  // version; localMap() is not changed yet); refineKeyframe() does steps 3-5 for the keyframe
+  // addKeyframe() just inserted (local BA, culling again) and publishes the refined snapshot as
+  // localMap(). It returns whether it refined anything: false after a failed insertion (nothing
+  // published) and after a new map (no BA there: localMap() is published, with the fresh
+  // snapshot's content).
+  InsertResult addKeyframe(const KeyframeRequest& request, LocalMap* fresh);
+  bool refineKeyframe(InsertResult* result);
   // Loop closing's correction (pipeline/odometry/map_correction.h): ONE rigid motion
   // C = correction.T_world_cam * T_world_keyframe^-1 moves every keyframe and landmark of the map,
   // then a new snapshot is published (the tracker follows through its reference keyframe).
@@ -96,6 +107,9 @@ class LocalMapper {
   void retireAll();
 
  private:
+  // Steps 1-2 of insertKeyframe (no snapshot); remembers the keyframe for the refinement.
+  InsertResult addUnrefined(const KeyframeRequest& request);
+  void recordPeakCounts();
   void retireKeyframe(int kf_slot);
   void applyVisibility(const KeyframeRequest& request);
   void addTrackedObservations(int kf_slot, const KeyframeRequest& request);
@@ -117,8 +131,9 @@ class LocalMapper {
   // True when a keyframe covariance from this BA may be published (solver/pose_covariance.h
   // publishablePoseCovariance, UncertaintyOptions::max_published_*); counts a refusal.
   bool publishable(const Matrix6d& covariance);
-  // local_mapper_snapshot.cpp
-  void publishSnapshot(int kf_slot);
+  // local_mapper_snapshot.cpp: publishSnapshot builds localMap(), buildSnapshot any LocalMap.
+  void publishSnapshot(int kf_slot) { buildSnapshot(kf_slot, local_map_.get()); }
+  void buildSnapshot(int kf_slot, LocalMap* out);
   void rankCovisible(int kf_slot, int count, FixedVector<int, kMaxMapKeyframes>* out) const;
 
   PinholeCamera camera_;
@@ -129,6 +144,10 @@ class LocalMapper {
   LocalBundleAdjuster ba_;
   uint32_t segment_ = 0;
   uint64_t snapshot_version_ = 0;
+  // The keyframe addUnrefined() inserted and no refinement has run for yet (-1: none), and whether
+  // it started a new map (nothing to refine then).
+  int unrefined_slot_ = -1;
+  bool unrefined_new_map_ = false;
   // The last correction: snapshots older than this version are in the frame before it.
   uint64_t correction_version_ = 0;
   Eigen::Isometry3d last_correction_ = Eigen::Isometry3d::Identity();

@@ -5,8 +5,8 @@
 
 namespace plumb {
 
-void LocalMapper::publishSnapshot(int kf_slot) {
-  LocalMap& out = *local_map_;
+void LocalMapper::buildSnapshot(int kf_slot, LocalMap* out_map) {
+  LocalMap& out = *out_map;
   out.clear();
   out.version = ++snapshot_version_;
   out.segment = segment_;

@@ -32,6 +32,16 @@ Status validate(const SystemOptions& options) {
   if (options.map_lag_frames < 1 || options.map_lag_frames > SystemOptions::kMaxMapLagFrames) {
     return Status::Error("map lag must be within 1.." + std::to_string(SystemOptions::kMaxMapLagFrames) + " frames");
   }
+  if (options.refine_lag_frames < 0 || options.refine_lag_frames > SystemOptions::kMaxRefineLagFrames) {
+    return Status::Error("refine lag must be within 0.." + std::to_string(SystemOptions::kMaxRefineLagFrames) +
+                         " frames");
+  }
+  if (options.refine_lag_frames > 0 && options.map_lag_frames != 1) {
+    // With L > 1 a later request's fresh map could be due after an earlier refined one that the
+    // mapper has already overwritten: the rule would not be one order in every schedule.
+    return Status::Error("a map lag of " + std::to_string(options.map_lag_frames) +
+                         " frames needs refine lag 0 (split map updates need map lag 1)");
+  }
   const std::string uncertainty = validate(options.odometry.uncertainty);
   if (!uncertainty.empty()) return Status::Error("uncertainty options: " + uncertainty);
   if (options.output_delay_frames < 0 || options.output_delay_frames >= OdometryTrajectory::kMaxDelayFrames) {
@@ -65,6 +75,7 @@ OdometrySystem::OdometrySystem(const PinholeCamera& camera, const SystemOptions&
       corrections_(std::make_unique<runtime::LatestSnapshot<MapCorrection>>()) {
   tracking_.tracker = std::make_unique<Tracker>(camera, options.odometry);
   mapping_.mapper = std::make_unique<LocalMapper>(camera, options.odometry);
+  if (options.splitMapUpdates()) fresh_map_ = std::make_unique<LocalMap>();
 }
 
 OdometrySystem::~OdometrySystem() = default;
@@ -75,14 +86,18 @@ OdometrySystem::~OdometrySystem() = default;
 void OdometrySystem::installNewestSnapshot() {
   uint64_t version = 0;
   const LocalMap* snapshot = snapshots_->acquireLatest(&version);
-  if (snapshot == nullptr || snapshot->version <= tracking_.tracker->localMap().version) return;
+  if (snapshot != nullptr) installSnapshot(*snapshot);
+}
+
+void OdometrySystem::installSnapshot(const LocalMap& snapshot) {
+  if (snapshot.version <= tracking_.tracker->localMap().version) return;
   // The first snapshot after a new-map request is that map (the mapping side handles frames in
   // order, and the request's frame has been mapped before the next one is tracked).
   if (tracking_.new_map_requested) {
-    tracking_.tracker->adoptNewMap(*snapshot);
+    tracking_.tracker->adoptNewMap(snapshot);
     tracking_.new_map_requested = false;
   } else {
-    tracking_.tracker->setLocalMap(*snapshot);
+    tracking_.tracker->setLocalMap(snapshot);
   }
 }
 
@@ -106,15 +121,40 @@ bool OdometrySystem::canStartMap(const FrameFeatures& features) const {
 // map in between (no keyframe decision while a request is pending; in these schedules the loop
 // stage runs on the map stage's thread, right after the keyframe), so every frame is tracked
 // against the same map in both schedules: the same bytes, however the threads are timed.
+// Split updates (refine_lag_frames M >= 1, map_lag_frames 1): at frame k + 1 the fresh map (the
+// fast schedule waits only until the map stage has written it, MapperFence::waitUntilInserted), at
+// k + 1 + M the newest whole snapshot, waiting until frame k is mapped completely. That snapshot is
+// k's own (or the correction of a loop k closed): a later request k' would have had its fresh map
+// installed at k' + 1 <= k + 1 + M, replacing this pending refinement with its own.
 bool OdometrySystem::syncWithMapping(MapperFence* fence) {
   const uint64_t frame = tracking_.frames++;
   if (fence != nullptr && fence->maxFramesAhead() > 0) return syncWithNewestSnapshot(*fence);
-  if (!tracking_.update_pending) return false;
-  if (frame < tracking_.update_due) return true;
-  if (fence != nullptr && fence->waitUntilMapped(tracking_.update_frame + 1)) ++tracking_.mapper_waits;
-  installNewestSnapshot();
-  tracking_.update_pending = false;
+  if (tracking_.update_pending) {
+    if (frame < tracking_.update_due) return true;
+    installDueUpdate(fence);
+  } else if (tracking_.refinement_pending && frame >= tracking_.refinement_due) {
+    if (fence != nullptr && fence->waitUntilMapped(tracking_.refinement_frame + 1)) ++tracking_.mapper_waits;
+    installNewestSnapshot();
+    tracking_.refinement_pending = false;
+  }
   return false;
+}
+
+// The update of the request of frame update_frame, at its due frame: the whole update, or the
+// fresh map of a split one (and its refinement becomes the pending one).
+void OdometrySystem::installDueUpdate(MapperFence* fence) {
+  tracking_.update_pending = false;
+  const uint64_t frames_mapped = tracking_.update_frame + 1;  // the request's frame included
+  if (!options_.splitMapUpdates()) {
+    if (fence != nullptr && fence->waitUntilMapped(frames_mapped)) ++tracking_.mapper_waits;
+    installNewestSnapshot();
+    return;
+  }
+  if (fence != nullptr && fence->waitUntilInserted(frames_mapped)) ++tracking_.mapper_waits;
+  installSnapshot(*fresh_map_);
+  tracking_.refinement_pending = !tracking_.update_new_map;  // a new map has no BA to wait for
+  tracking_.refinement_frame = tracking_.update_frame;
+  tracking_.refinement_due = tracking_.update_frame + 1 + uint64_t(options_.refine_lag_frames);
 }
 
 // Real time (fence->maxFramesAhead() > 0): the newest snapshot published so far, with bounded
@@ -139,9 +179,10 @@ bool OdometrySystem::syncWithNewestSnapshot(MapperFence& fence) {
 }
 
 // The frame being tracked asked the mapping side for a map update (a keyframe or a new map).
-void OdometrySystem::expectMapUpdate(int lag_frames) {
+void OdometrySystem::expectMapUpdate(int lag_frames, bool new_map) {
   ++tracking_.keyframe_requests;
   tracking_.update_pending = true;
+  tracking_.update_new_map = new_map;
   tracking_.update_frame = tracking_.frames - 1;
   tracking_.update_due = tracking_.update_frame + uint64_t(lag_frames);
 }
@@ -156,7 +197,7 @@ void OdometrySystem::requestNewMap(const FrameFeatures& features, uint64_t seque
   tracking_.lost_streak = 0;
   tracking_.new_map_requested = true;
   out->map_keyframe = true;
-  expectMapUpdate(1);
+  expectMapUpdate(1, true);
   FrameOutput& o = out->output;
   o.state = TrackingState::kOk;
   o.has_pose = true;
@@ -235,7 +276,7 @@ void OdometrySystem::trackAgainstMap(const FrameFeatures& features, uint64_t seq
   out->reference_id = snapshot.reference_keyframe_id;
   out->T_ref_cam = snapshot.T_world_reference.inverse() * o.T_world_cam;
   out->map_keyframe = o.track.keyframe_requested;
-  if (out->map_keyframe) expectMapUpdate(options_.map_lag_frames);
+  if (out->map_keyframe) expectMapUpdate(options_.map_lag_frames, false);
 }
 
 void OdometrySystem::trackFeatures(const FrameFeatures& features, uint64_t sequence, double timestamp_s,
@@ -284,14 +325,27 @@ void OdometrySystem::trackFeatures(const FrameFeatures& features, uint64_t seque
 // ---------------------------------------------------------------------------------------------
 // Mapping side
 
-void OdometrySystem::insertKeyframe(const KeyframeRequest& request) {
-  const InsertResult inserted = mapping_.mapper->insertKeyframe(request);
+void OdometrySystem::insertKeyframe(const KeyframeRequest& request, bool split, MapperFence* fence) {
+  LocalMapper& mapper = *mapping_.mapper;
+  InsertResult inserted;
+  bool refined = true;
+  if (split) {
+    inserted = mapper.addKeyframe(request, fresh_map_.get());
+    // The tracker may go on with the next frame now, against the fresh map, while the BA runs.
+    if (fence != nullptr) fence->insertionPublished();
+    refined = mapper.refineKeyframe(&inserted);
+  } else {
+    inserted = mapper.insertKeyframe(request);
+  }
   mapping_.output.insert = inserted;
   if (!inserted.inserted) return;
-  const LocalMap& snapshot = mapping_.mapper->localMap();
-  // Copied into the channel's preallocated buffer; the tracker installs it before its next frame.
-  snapshots_->writeBuffer() = snapshot;
-  snapshots_->publish(snapshot.version);
+  const LocalMap& snapshot = mapper.localMap();
+  // Copied into the channel's preallocated buffer; the tracker installs it when it is due. A new
+  // map's split update is its fresh map alone.
+  if (refined) {
+    snapshots_->writeBuffer() = snapshot;
+    snapshots_->publish(snapshot.version);
+  }
   relocalizer_->addKeyframe(inserted.keyframe_id, request.T_world_cam, request.features);
   // Stored keyframes follow local BA's refinements while they are in the map.
   for (const LocalMapKeyframe& kf : snapshot.keyframes) relocalizer_->updatePose(kf.id, kf.T_world_cam);
@@ -318,15 +372,17 @@ bool OdometrySystem::applyLoopCorrection() {
   return true;
 }
 
-const FrameOutput& OdometrySystem::mapFrame(const TrackedFrame& tracked) {
+const FrameOutput& OdometrySystem::mapFrame(const TrackedFrame& tracked, MapperFence* fence) {
   // A loop correction first: this frame's keyframe (if any) is inserted into the corrected map.
   applyLoopCorrection();
+  // Real time tracks on the newest whole update (syncWithNewestSnapshot): no split there.
+  const bool split = options_.splitMapUpdates() && (fence == nullptr || fence->maxFramesAhead() == 0);
   mapping_.output = tracked.output;
   uint32_t reference_id = tracked.reference_id;
   Eigen::Isometry3d T_ref_cam = tracked.T_ref_cam;
   if (tracked.map_keyframe) {
     const auto map_start = std::chrono::steady_clock::now();
-    insertKeyframe(tracked.request);
+    insertKeyframe(tracked.request, split, fence);
     keyframe_requests_done_.fetch_add(1, std::memory_order_release);
     mapping_.output.map_ms = millisecondsSince(map_start);
     if (mapping_.output.keyframe) {

@@ -149,7 +149,7 @@ Status MapStage::writeDrops(uint32_t count) {
 Status MapStage::process(OdometrySlot& slot, const runtime::FrameStamps& stamps) {
   Status status = writeDrops(slot.dropped_before);
   ++frames_;
-  const FrameOutput& out = system_.mapFrame(*slot.tracked);
+  const FrameOutput& out = system_.mapFrame(*slot.tracked, &fence_);
   // Before the fence releases the mapper: the record reads the mapper's poses.
   if (loop_ != nullptr) loop_->keyframeInserted(*slot.tracked, out);
   const Status s = deliver(out);

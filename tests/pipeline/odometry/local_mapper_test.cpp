@@ -226,6 +226,55 @@ TEST(LocalMapper, LocalBaHoldsTheFirstKeyframeAndPullsAPerturbedOneToTheTruth) {
   EXPECT_TRUE(map.T_world_reference.isApprox(map.keyframes[1].T_world_cam, 1e-15));
 }
 
+// Split map updates: addKeyframe() hands out the keyframe at its tracked pose with its new
+// landmarks before any BA, refineKeyframe() then publishes the BA's map (the scene of the test
+// above: the tracked pose 1 cm off, which the BA corrects).
+TEST(LocalMapper, AddKeyframeGivesTheFreshMapAndRefineKeyframeTheAdjustedOne) {
+  const test::Scene scene = test::makeScene(15, 300, 0, kStart, 1.0, 4.0);
+  Fixture fx;
+  LocalMap fresh;
+  InsertResult first = fx.mapper->addKeyframe(*test::newMapRequest(test::observe(scene, kStart), kStart, 0), &fresh);
+  ASSERT_TRUE(first.inserted);
+  EXPECT_EQ(fresh.reference_keyframe_id, first.keyframe_id);
+  EXPECT_EQ(fx.mapper->localMap().version, 0u);  // not published before refineKeyframe()
+  EXPECT_FALSE(fx.mapper->refineKeyframe(&first)) << "a new map has no BA";
+  EXPECT_GT(fx.mapper->localMap().version, fresh.version);
+  EXPECT_EQ(fx.mapper->localMap().points.size(), fresh.points.size());
+  EXPECT_FALSE(fx.mapper->refineKeyframe(&first)) << "nothing left to refine";
+
+  const Eigen::Isometry3d T_true = kStart * pose(2, Eigen::Vector3d(0, 1, 0.3), Eigen::Vector3d(0.05, 0.01, 0.02));
+  const Eigen::Isometry3d T_tracked = pose(0.3, Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0.006, -0.006, 0.005)) * T_true;
+  const test::View view = test::observe(scene, T_true);
+  const auto request = trackedRequest(view, T_tracked, 1, fx.mapper->localMap(), 200);
+  const uint64_t published = fx.mapper->localMap().version;
+  InsertResult r = fx.mapper->addKeyframe(*request, &fresh);
+  ASSERT_TRUE(r.inserted);
+  EXPECT_EQ(r.ba_initial_cost, 0.0);  // no BA yet
+  EXPECT_EQ(fx.mapper->localMap().version, published);
+  EXPECT_GT(fresh.version, published);
+  EXPECT_EQ(fresh.reference_keyframe_id, r.keyframe_id);
+  EXPECT_TRUE(fresh.T_world_reference.isApprox(T_tracked, 1e-15)) << "the tracked pose, unrefined";
+  EXPECT_EQ(fresh.keyframes_in_map, 2);
+  // The new keyframe's landmarks are in the fresh map, placed from the tracked pose.
+  int new_landmarks = 0;
+  for (const LocalMapPoint& p : fresh.points) {
+    for (std::size_t k = 200; k < view.features->keypoints.size(); ++k) {
+      if (!sameDescriptor(p.descriptor, view.features->keypoint_descriptors[k])) continue;
+      const Eigen::Vector3d P_cam = view.features->keypoints[k].P_cam.cast<double>();
+      new_landmarks += (p.P_world - T_tracked * P_cam).norm() < 1e-9;  // the other copy is the first keyframe's
+    }
+  }
+  EXPECT_EQ(new_landmarks, r.new_points);
+
+  EXPECT_TRUE(fx.mapper->refineKeyframe(&r));
+  EXPECT_LT(r.ba_final_cost, 0.01 * r.ba_initial_cost);
+  const LocalMap& refined = fx.mapper->localMap();
+  EXPECT_GT(refined.version, fresh.version);
+  EXPECT_EQ(refined.reference_keyframe_id, r.keyframe_id);
+  EXPECT_LT(translationError(refined.T_world_reference, T_true), 1e-3);
+  EXPECT_GT(translationError(fresh.T_world_reference, T_true), 0.009);
+}
+
 // Which scene points (by index) have a landmark in the snapshot.
 std::vector<bool> scenePointsInMap(const test::Scene& scene, const LocalMap& map) {
   std::vector<bool> in_map(scene.points.size(), false);
