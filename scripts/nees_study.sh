@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The NEES study of docs/UNCERTAINTY.md: mean NEES per dof of every published covariance.
-#  - Monte Carlo: plumb_nees_study over SEEDS seeds of synth:textured (and a tenth of that of
-#    synth:low_texture) with the renderer's Kinect-like noise, exact ground truth, two processes;
+#  - Monte Carlo: plumb_nees_study over SEEDS seeds of synth:textured (and a fifth of that of
+#    synth:low_texture, synth:office_loop and synth:office_pass) with the renderer's Kinect-like noise, exact ground truth, two processes;
 #  - real: TUM fr1/rpy head250 (whole, and its two halves: the first calibrated the
 #    rolling-shutter terms, the second checks them) and fr1/desk first9, motion-capture truth,
 #    through `plumb run --covariance --track-covariance --output-delay 0 --no-loops` and
@@ -67,6 +67,9 @@ echo "| sequence | keyframe-to-keyframe (BA joint marginal) | tracked pose (MAVL
 echo "|---|---|---|---|"
 monte_carlo textured "$SEEDS"
 monte_carlo low_texture $(( SEEDS > 10 ? SEEDS / 5 : 2 ))
+# The office scenes (long straight edges: the line-rich case of issue 20).
+monte_carlo office_loop $(( SEEDS > 10 ? SEEDS / 5 : 2 ))
+monte_carlo office_pass $(( SEEDS > 10 ? SEEDS / 5 : 2 ))
 RPY="$DATA/tum_fr1_rpy_head250"
 DESK="$DATA/tum_fr1_desk_first9"
 if [ -d "$RPY" ]; then

@@ -67,6 +67,7 @@
 #include "solver/camera_intrinsics.h"
 #include "solver/robust_kernel.h"
 #include "solver/types.h"
+#include "solver/variance_factor.h"
 #include "solver/zero_page_allocator.h"
 
 namespace plumb {
@@ -90,6 +91,17 @@ struct LocalBaOptions {
   // Eigenvalues of a 3x3 landmark block below this fraction of its largest one are treated as
   // exact zeros (pseudo-inverse; see DEGENERATE LANDMARKS above).
   double landmark_singular_threshold = 1e-10;
+  // computeCovariance() refuses the covariance when, for some pose variable k, C_kk * H_kk exceeds
+  // this: H_kk is the variable's own information (everything else known), 1 / C_kk its marginal
+  // information (landmarks and other poses eliminated), so the product says how much of the
+  // information the elimination cancelled (a variance inflation factor, independent of units).
+  // The cancellation is computed in floating point with an error of ~1e-13 of H_kk: a direction
+  // the observations do not fix leaves a pivot of that size and EITHER sign. Measured: genuine
+  // windows reach 2.8e7 (synth:office_loop:1 with noise; head250 2.7e6), a window with a null
+  // direction 5e13 (synth:fast_rotation:1 noise-free, where the sign came out positive and one
+  // keyframe published 1e7-3e9 m^2/rad^2 against 1e-7 for its neighbours). At 1e9 a marginal is
+  // still ~1e4 times its rounding error. docs/UNCERTAINTY.md "A degenerate window".
+  double covariance_max_variance_inflation = 1e9;
 
   RobustKernel kernelFor(ObservationKind kind) const {
     return {kernel, kind == ObservationKind::kStereoPoint ? kernel_delta_stereo
@@ -101,6 +113,22 @@ struct LocalBaOptions {
            : kind == ObservationKind::kMonoPoint ? chi2.mono
                                                  : chi2.line;
   }
+};
+
+// Scales on the model's information by residual kind, for computeCovariance(): the reciprocals of
+// the variance components the residuals support (LocalBundleAdjuster::varianceComponents).
+struct InformationScales {
+  double pixel = 1.0;  // points' [u, v] (stereo and mono)
+  double depth = 1.0;  // stereo points' disparity u - u_r
+  double line = 1.0;   // line samples' distance to the 2D line
+};
+
+// A posteriori variance components of the points' two noise sources (solver/variance_factor.h):
+// pixel detection and depth, each the model's noise times its own factor.
+struct PointVarianceComponents {
+  double pixel = 1.0;
+  double depth = 1.0;
+  double redundancy = 0.0;  // of the point residuals, shared by the two in proportion to their dof
 };
 
 enum class LocalBaStatus {
@@ -151,8 +179,11 @@ class LocalBundleAdjuster {
   LocalBaSummary solve(const LocalBaOptions& options);
 
   // Linearise at the current estimate (undamped) and compute C = S^-1. Returns false when S is
-  // not positive definite (e.g. no fixed keyframe, or a keyframe without constraints).
-  bool computeCovariance(const LocalBaOptions& options);
+  // not positive definite (e.g. no fixed keyframe, or a keyframe without constraints), or
+  // numerically singular (options.covariance_max_variance_inflation).
+  // `scales` multiply the information of each residual kind in that linearisation only (the
+  // variance components of docs/UNCERTAINTY.md; the solution is not touched).
+  bool computeCovariance(const LocalBaOptions& options, const InformationScales& scales = InformationScales());
   Matrix6d covariance(int keyframe) const;  // zero for fixed keyframes
   Eigen::Block<const Eigen::MatrixXd> fullCovariance() const;
   int numPoseVariables() const { return num_pose_variables_; }
@@ -172,6 +203,15 @@ class LocalBundleAdjuster {
   // Read it before computeCovariance(), which may re-linearise (and so re-evaluate the chi2 values
   // and reset the outlier flags; docs/SOLVER.md). local_ba_variance.cpp.
   double varianceFactor(const LocalBaOptions& options) const;
+  // Variance components of the POINT residuals after solve() (before computeCovariance(), like
+  // varianceFactor): the stereo residual [u, v, u_r] is split into its pixel part [u, v] and its
+  // depth part, the disparity u - u_r, in which the model's information is block diagonal (the
+  // two are independent sensors: corner detection and the depth camera), and each part's inlier
+  // chi2 is divided by its share of the points' redundancy (error dof - 6 per optimised pose - 3
+  // per point landmark, shared in proportion to the parts' dof: a point seen V times has 2V - 2
+  // pixel and V - 1 depth redundancy). Line samples are left out: see docs/UNCERTAINTY.md (their
+  // residuals cannot show their noise). A part whose redundancy is below min_redundancy gets 1.
+  PointVarianceComponents varianceComponents(const LocalBaOptions& options, int min_redundancy = 30) const;
 
   // Diagnostics (tests): linearise at the current estimate and solve ONE damped step with the
   // given lambda, without applying it. Returns false if the damped S is not positive definite.
@@ -253,6 +293,7 @@ class LocalBundleAdjuster {
   // The stored linearisation (blocks, IRLS weights, valid flags) is at the current estimate and
   // the observation set has not changed since: computeCovariance() can eliminate from it.
   bool linearized_at_estimate_ = false;
+  InformationScales information_scales_;  // computeCovariance's; all 1 while solving
 };
 
 }  // namespace plumb

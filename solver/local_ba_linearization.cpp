@@ -10,6 +10,7 @@
 #include "solver/dense_cholesky.h"
 #include "solver/factors.h"
 #include "solver/local_ba.h"
+#include "solver/noise_model.h"
 #include "solver/point_space_blocks.h"
 #include "solver/schur_kernels.h"
 
@@ -131,15 +132,21 @@ double LocalBundleAdjuster::linearize(const LocalBaOptions& options) {
           const Eigen::Vector3d omega_e = obs.information * e;
           obs.chi2 = e.dot(omega_e);
           k = evaluateKernel(kernel, obs.chi2);
-          stereoPointSpaceBlocks(J_cam, obs.information, omega_e, k.rho1, &M, &q);
+          if (information_scales_.pixel == 1.0 && information_scales_.depth == 1.0) {
+            stereoPointSpaceBlocks(J_cam, obs.information, omega_e, k.rho1, &M, &q);
+          } else {  // computeCovariance with variance components
+            const Eigen::Matrix3d omega =
+                scaleStereoInformation(obs.information, information_scales_.pixel, information_scales_.depth);
+            stereoPointSpaceBlocks(J_cam, omega, omega * e, k.rho1, &M, &q);
+          }
           break;
         }
         case ObservationKind::kMonoPoint: {
           Eigen::Vector2d e;
           Matrix23d J_cam;
           monoResidualAt(camera_, P_cam, obs.z.head<2>(), &e, &J_cam);
-          const Eigen::Matrix2d omega = obs.information.topLeftCorner<2, 2>();
-          obs.chi2 = e.dot(omega * e);
+          const Eigen::Matrix2d omega = information_scales_.pixel * obs.information.topLeftCorner<2, 2>();
+          obs.chi2 = e.dot(obs.information.topLeftCorner<2, 2>() * e);
           k = evaluateKernel(kernel, obs.chi2);
           pointSpaceBlocks<2>(J_cam, k.rho1 * omega, e, &M, &q);
           break;
@@ -157,7 +164,7 @@ double LocalBundleAdjuster::linearize(const LocalBaOptions& options) {
           cost += 0.5 * k.rho;
           obs.valid = true;
           obs.outlier = false;
-          const double c = k.rho1 * obs.information(0, 0);
+          const double c = k.rho1 * obs.information(0, 0) * information_scales_.line;
           const Eigen::Vector3d j = J_cam.transpose();
           const Eigen::Vector3d r = kf.T_cam_world.linear().transpose() * j;
           const Eigen::Vector3d cr = c * r;

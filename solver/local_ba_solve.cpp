@@ -117,27 +117,44 @@ bool LocalBundleAdjuster::computeStep(const LocalBaOptions& options, double lamb
   return solveDamped(options, lambda);
 }
 
-bool LocalBundleAdjuster::computeCovariance(const LocalBaOptions& options) {
+bool LocalBundleAdjuster::computeCovariance(const LocalBaOptions& options, const InformationScales& scales) {
   covariance_valid_ = false;
   buildStructure();
-  if (linearized_at_estimate_) {
+  const bool unit_scales = scales.pixel == 1.0 && scales.depth == 1.0 && scales.line == 1.0;
+  if (linearized_at_estimate_ && unit_scales) {
     // solve() ended at its last linearisation point (its last step was rejected, or it ran no
-    // step): the stored blocks are this linearisation. Its flags as linearize() leaves them:
-    // an enabled observation is an outlier exactly when it was not linearised.
+    // step) and the covariance weighs the residuals as solve() did: the stored blocks are this
+    // linearisation. Its flags as linearize() leaves them: an enabled observation is an outlier
+    // exactly when it was not linearised.
     for (int k = 0; k < num_observations_; ++k) {
       Observation& obs = observations_[k];
       if (obs.enabled) obs.outlier = !obs.valid;
     }
   } else {
+    // Variance components weigh the residual kinds differently from solve(): linearise again.
+    information_scales_ = scales;
     linearize(options);
-    linearized_at_estimate_ = true;
+    information_scales_ = InformationScales();
+    linearized_at_estimate_ = unit_scales;
   }
   // lambda = 0: the undamped reduced system S = H_A - H_B H_C^-1 H_B^T, factorised in place.
   if (!solveDamped(options, 0.0)) return false;
   const Eigen::Index dim = 6 * static_cast<Eigen::Index>(num_pose_variables_);
   choleskyInverse(S_.topLeftCorner(dim, dim), covariance_.topLeftCorner(dim, dim));
-  covariance_valid_ = covariance_.topLeftCorner(dim, dim).allFinite();
-  return covariance_valid_;
+  if (!covariance_.topLeftCorner(dim, dim).allFinite()) return false;
+  // A direction the observations do not fix survives the factorisation as a pivot of rounding
+  // size and either sign: refuse it when a variable's marginal information 1 / C_kk is not well
+  // above the rounding error of the terms it was computed from (its own information H_kk).
+  for (int v = 0; v < num_pose_variables_; ++v) {
+    const Matrix6d& H = keyframes_[variable_keyframe_[v]].H_pose;
+    for (int d = 0; d < 6; ++d) {
+      const Eigen::Index k = 6 * v + d;
+      const double inflation = covariance_(k, k) * H(d, d);
+      if (!(inflation <= options.covariance_max_variance_inflation)) return false;
+    }
+  }
+  covariance_valid_ = true;
+  return true;
 }
 
 }  // namespace plumb

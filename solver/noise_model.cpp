@@ -37,6 +37,35 @@ double lineSampleInformation(const NoiseModelOptions& options, int pyramid_level
   return 1.0 / std::pow(pixelSigma(options, pyramid_level), 2);
 }
 
+namespace {
+
+// y = T z with y = [u, v, u - u_r]; T is its own inverse, so information_y = T^T information_z T
+// and back the same way.
+Eigen::Matrix3d disparityTransform() {
+  Eigen::Matrix3d T = Eigen::Matrix3d::Identity();
+  T(2, 0) = 1.0;
+  T(2, 2) = -1.0;
+  return T;
+}
+
+}  // namespace
+
+void splitStereoChi2(const Eigen::Matrix3d& information, const Eigen::Vector3d& e, double* pixel_chi2,
+                     double* depth_chi2) {
+  const Eigen::Matrix3d T = disparityTransform();
+  const Eigen::Matrix3d information_y = T.transpose() * information * T;
+  const Eigen::Vector3d e_y = T * e;
+  *pixel_chi2 = e_y.head<2>().dot(information_y.topLeftCorner<2, 2>() * e_y.head<2>());
+  *depth_chi2 = e_y(2) * e_y(2) * information_y(2, 2);
+}
+
+Eigen::Matrix3d scaleStereoInformation(const Eigen::Matrix3d& information, double pixel_scale, double depth_scale) {
+  const Eigen::Matrix3d T = disparityTransform();
+  const Eigen::Vector3d d(std::sqrt(pixel_scale), std::sqrt(pixel_scale), std::sqrt(depth_scale));
+  const Eigen::Matrix3d information_y = d.asDiagonal() * (T.transpose() * information * T) * d.asDiagonal();
+  return T.transpose() * information_y * T;
+}
+
 Eigen::Matrix3d backProjectedPointCovariance(const NoiseModelOptions& options,
                                              const CameraIntrinsics& camera, double u, double v,
                                              double depth_m, int pyramid_level) {

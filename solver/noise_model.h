@@ -44,6 +44,17 @@ Eigen::Matrix2d monoPointInformation(const NoiseModelOptions& options, int pyram
 // l normalised): 1 / sigma_p(level)^2.
 double lineSampleInformation(const NoiseModelOptions& options, int pyramid_level);
 
+// The stereo residual [u, v, u_r] in the coordinates of its two noise sources, [u, v] (corner
+// detection) and the disparity u - u_r = bf / d (depth), where the model's information is block
+// diagonal. Used by the variance components (solver/local_ba.h, docs/UNCERTAINTY.md).
+// chi2 of the pixel part and of the depth part of residual e under `information` (their sum is
+// e^T information e when the information is the model's; cross terms, if any, are left out).
+void splitStereoChi2(const Eigen::Matrix3d& information, const Eigen::Vector3d& e, double* pixel_chi2,
+                     double* depth_chi2);
+// `information` with its pixel block scaled by pixel_scale and its disparity part by depth_scale
+// (cross terms by their geometric mean, which keeps it positive semi-definite).
+Eigen::Matrix3d scaleStereoInformation(const Eigen::Matrix3d& information, double pixel_scale, double depth_scale);
+
 // Covariance (camera frame, m^2) of the 3D point back-projected from pixel (u, v) with depth d:
 // P = [(u - cx) d / fx, (v - cy) d / fy, d], propagated from diag(sp^2, sp^2, sd^2).
 Eigen::Matrix3d backProjectedPointCovariance(const NoiseModelOptions& options,

@@ -45,6 +45,10 @@ struct MapperStats {
   uint64_t lines_culled = 0;
   uint64_t ba_runs = 0;
   uint64_t ba_outlier_observations = 0;
+  // BA covariances not published: windows whose reduced system was (numerically) singular, and
+  // keyframe covariances not finite, not positive definite or beyond
+  // UncertaintyOptions::max_published_*. The keyframes keep the last BA's.
+  uint64_t ba_covariances_refused = 0;
   uint64_t stale_associations = 0;  // request named a landmark that is gone meanwhile
   MapCounts peak;                   // largest counts seen (capacity check)
 };
@@ -124,6 +128,9 @@ class LocalMapper {
   // covariance chained from its previous keyframe's.
   void writeUncertainty(int kf_slot, bool have_covariance, double variance_factor);
   int previousKeyframeSlot(uint32_t id) const;
+  // True when a keyframe covariance from this BA may be published (solver/pose_covariance.h
+  // publishablePoseCovariance, UncertaintyOptions::max_published_*); counts a refusal.
+  bool publishable(const Matrix6d& covariance);
   // local_mapper_snapshot.cpp: publishSnapshot builds localMap(), buildSnapshot any LocalMap.
   void publishSnapshot(int kf_slot) { buildSnapshot(kf_slot, local_map_.get()); }
   void buildSnapshot(int kf_slot, LocalMap* out);

@@ -216,8 +216,21 @@ void LocalMapper::runLocalBa(int kf_slot, InsertResult* result) {
   }
 
   // Write back poses, landmarks, covariances.
-  const double variance_factor = ba_.varianceFactor(ba_options_);  // before: the covariance re-evaluates chi2
-  const bool have_covariance = ba_.computeCovariance(ba_options_);
+  // Before computeCovariance, which re-evaluates chi2. With variance components the factors are in
+  // the information (pixel and depth parts of the points each by their own, line samples as
+  // modelled) and the pooled factor is 1 (docs/UNCERTAINTY.md).
+  const UncertaintyOptions& u = options_.uncertainty;
+  double variance_factor = 1.0;
+  InformationScales scales;
+  if (u.use_variance_factor && u.variance_components) {
+    const PointVarianceComponents components = ba_.varianceComponents(ba_options_);
+    scales.pixel = 1.0 / components.pixel;
+    scales.depth = 1.0 / components.depth;
+  } else if (u.use_variance_factor) {
+    variance_factor = ba_.varianceFactor(ba_options_);
+  }
+  const bool have_covariance = ba_.computeCovariance(ba_options_, scales);
+  if (!have_covariance) ++stats_.ba_covariances_refused;  // singular: the keyframes keep the last BA's
   for (int slot : window) {
     Keyframe& kf = map_.keyframe(slot);
     const int index = s_->ba_keyframe_index[slot];
@@ -227,9 +240,11 @@ void LocalMapper::runLocalBa(int kf_slot, InsertResult* result) {
     if (have_covariance) {
       // Calibrated like the relative covariances (docs/UNCERTAINTY.md); its gauge is this BA's
       // fixed keyframes.
-      const UncertaintyOptions& u = options_.uncertainty;
-      kf.covariance = (u.use_variance_factor ? variance_factor : 1.0) * u.relative_scale * ba_.covariance(index);
-      kf.covariance_valid = true;
+      const Matrix6d covariance = variance_factor * u.relative_scale * ba_.covariance(index);
+      if (publishable(covariance)) {
+        kf.covariance = covariance;
+        kf.covariance_valid = true;
+      }
     }
   }
   moveSingleViewLandmarks();

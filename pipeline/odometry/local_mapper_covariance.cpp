@@ -6,6 +6,14 @@
 
 namespace plumb {
 
+bool LocalMapper::publishable(const Matrix6d& covariance) {
+  const UncertaintyOptions& u = options_.uncertainty;
+  if (publishablePoseCovariance(covariance, u.max_published_translation_sigma_m, u.max_published_rotation_sigma_rad))
+    return true;
+  ++stats_.ba_covariances_refused;
+  return false;
+}
+
 int LocalMapper::previousKeyframeSlot(uint32_t id) const {
   int previous = -1;
   for (int s = 0; s < int(kMaxMapKeyframes); ++s) {
@@ -44,6 +52,7 @@ void LocalMapper::writeUncertainty(int kf_slot, bool have_covariance, double var
       const Matrix6d rolling_shutter = rollingShutterCovariance(u, readout_s);
       const Matrix6d ba_relative = inflateRelativeCovariance(
           u, relativePoseCovariance(T_i, T_j, block(i, i), block(j, j), block(i, j)), variance_factor);
+      if (!publishable(ba_relative)) continue;  // keep the last relative (and chain the default)
       // Chained: each keyframe adds its own rolling-shutter error once (it shapes the landmarks made
       // from it, so it stays in the map); the relative pose sees the errors of both ends.
       if (slot == kf_slot) chain_relative = ba_relative + rolling_shutter;

@@ -21,6 +21,9 @@ std::string validate(const UncertaintyOptions& o) {
   if (!(o.default_translation_sigma_m > 0 && o.default_rotation_sigma_rad > 0 && o.segment_translation_sigma_m > 0 &&
         o.segment_rotation_sigma_rad > 0))
     return "the default and segment sigmas must be > 0 (they are chained as covariances)";
+  if (!(o.max_published_translation_sigma_m > 0 && o.max_published_rotation_sigma_rad > 0 &&
+        o.max_published_translation_sigma_m <= 1e6 && o.max_published_rotation_sigma_rad <= 1e6))
+    return "max_published_translation_sigma_m and max_published_rotation_sigma_rad must be in (0, 1e6]";
   return "";
 }
 

@@ -13,13 +13,25 @@ struct UncertaintyOptions {
   // Scale BA's and pose-only's covariances by their a posteriori variance factor sigma0^2
   // (solver/variance_factor.h): the noise level the residuals show instead of the model's.
   bool use_variance_factor = true;
+  // Local BA only: instead of one pooled factor, the points' pixel residuals and their depth
+  // (disparity) residuals each get their own a posteriori factor (variance components: two
+  // independent sensors whose model errors differ, e.g. a rendering's corners are 3x better than
+  // the 1 px model and its depth is as modelled), and line samples keep the model's information:
+  // their residuals cannot show their noise (each sample's own 3D point absorbs all but V - 2 of
+  // its V residuals, and the samples of one line share the one 2D line of each image), yet pooled
+  // they counted as redundancy and pulled everyone's factor down (synth office scenes: 0.16
+  // pooled, 0.30 from points alone). docs/UNCERTAINTY.md "Variance components". relative_scale
+  // is calibrated WITH this on; with it off (the pooled factor) the calibrated value was 1.8.
+  bool variance_components = true;
   // Scale on local BA's relative-pose covariance (keyframe to keyframe) and model-error floor
   // sigmas added to it (independent per keyframe pair).
-  // 1.8 / 1.5: Monte Carlo calibration on synthetic scenes (docs/UNCERTAINTY.md): the errors of
+  // 1.2 / 1.5: Monte Carlo calibration on synthetic scenes (docs/UNCERTAINTY.md): the errors of
   // one landmark's observations are correlated across frames (the same corner of the same texture
   // is detected with the same offset from nearby viewpoints), so the independent-noise information
-  // overstates what the observations know even after the variance factor.
-  double relative_scale = 1.8;
+  // overstates what the observations know even after the variance factor. relative_scale was 1.8
+  // with the pooled factor; with variance_components (below) synth:textured seeds 11-30 gave
+  // NEES/dof 0.662 at 1.8, so 1.8 * 0.662 = 1.2.
+  double relative_scale = 1.2;
   // Floors: off. The model errors measured so far are explained by the terms below; a floor in
   // metres would claim the same absolute error for a slow robot and a fast hand.
   double relative_floor_translation_m = 0.0;
@@ -74,6 +86,14 @@ struct UncertaintyOptions {
   // Relative covariance used for chaining when local BA gave none (the loop closer's default).
   double default_translation_sigma_m = 0.02;
   double default_rotation_sigma_rad = 0.01;
+  // Physical bounds on a keyframe covariance local BA publishes (its marginal, whose gauge is the
+  // window's fixed keyframes a few keyframes away, and the relative pose to its previous keyframe):
+  // a keyframe the tracker placed is never that uncertain against its neighbours (1 m, 29 deg), so
+  // a larger one is a numerical failure, not a measurement. Refused (the last BA's value is kept,
+  // counted as ba_covariances_refused in --stats). The loop closer's odometry-edge bound is the
+  // same (LoopCloserOptions::max_edge_*).
+  double max_published_translation_sigma_m = 1.0;
+  double max_published_rotation_sigma_rad = 0.5;
   // World covariance of the first keyframe of a later map segment (started at the last known pose
   // after tracking was lost: that pose is a guess; the loop closer's weak segment edge).
   double segment_translation_sigma_m = 1.0;

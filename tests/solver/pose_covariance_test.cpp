@@ -103,5 +103,32 @@ TEST(PoseCovariance, NeesOfKnownErrorsAndRefusal) {
   EXPECT_TRUE(std::isnan(normalizedErrorSquared(e, C)));
 }
 
+// What local BA may publish: finite, positive definite, and its largest sigmas within the bounds
+// (the largest eigenvalue of each 3x3 block: a correlated covariance whose diagonal is within the
+// bound can still exceed it along a diagonal direction).
+TEST(PoseCovariance, PublishableNeedsFiniteSpdAndPhysicalSigmas) {
+  Vector6d sigma;
+  sigma << 0.01, 0.02, 0.03, 0.001, 0.002, 0.003;
+  const Matrix6d good = Matrix6d(sigma.cwiseAbs2().asDiagonal());
+  EXPECT_TRUE(publishablePoseCovariance(good, 1.0, 0.5));
+  Matrix6d nan = good;
+  nan(2, 4) = std::nan("");
+  EXPECT_FALSE(publishablePoseCovariance(nan, 1.0, 0.5));
+  Matrix6d indefinite = good;
+  indefinite(5, 5) = -1e-9;
+  EXPECT_FALSE(publishablePoseCovariance(indefinite, 1.0, 0.5));
+  EXPECT_FALSE(publishablePoseCovariance(Matrix6d::Zero(), 1.0, 0.5));
+  Matrix6d far = good;
+  far(1, 1) = 1.1 * 1.1;  // 1.1 m
+  EXPECT_FALSE(publishablePoseCovariance(far, 1.0, 0.5));
+  EXPECT_TRUE(publishablePoseCovariance(far, 2.0, 0.5));
+  Matrix6d turned = good;
+  turned(3, 3) = turned(4, 4) = 0.4 * 0.4;  // 0.4 rad each, correlated: 0.55 rad along (1, 1)/sqrt 2
+  turned(3, 4) = turned(4, 3) = 0.9 * 0.4 * 0.4;
+  EXPECT_FALSE(publishablePoseCovariance(turned, 1.0, 0.5));
+  // The degenerate keyframe of synth:fast_rotation:1 (before the variance-inflation check): 3e9.
+  EXPECT_FALSE(publishablePoseCovariance(3e9 * Matrix6d::Identity(), 1.0, 0.5));
+}
+
 }  // namespace
 }  // namespace plumb

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <random>
 
+#include "solver/noise_model.h"
 #include "solver/variance_factor.h"
 #include "tests/support/synthetic_window.h"
 
@@ -48,24 +49,59 @@ TEST(VarianceFactor, RecoversTheScaleOfTruncatedChiSquareSums) {
 
 // A window whose pixel noise is half the model's 1 px: sigma0^2 ~ 0.25 for the pixel-dominated
 // errors (depth noise is drawn at the model's level, so the result lies between 0.25 and 1).
-TEST(VarianceFactor, LocalBaSeesNoiseBelowTheModel) {
+// The default synthetic window (depth noise drawn from the model) with this pixel noise, solved.
+void solveWindow(double pixel_noise, const LocalBaOptions& options, LocalBundleAdjuster* ba) {
   testing::SyntheticWindowConfig config;
-  config.pixel_noise = 0.5;
-  const testing::SyntheticWindow w = testing::makeSyntheticWindow(config);
+  config.pixel_noise = pixel_noise;
+  testing::loadWindow(testing::makeSyntheticWindow(config), true, ba);
+  ASSERT_TRUE(ba->solve(options).ok());
+}
+
+TEST(VarianceFactor, LocalBaSeesNoiseBelowTheModel) {
+  const LocalBaOptions options;
   LocalBundleAdjuster ba;
-  testing::loadWindow(w, true, &ba);
-  LocalBaOptions options;
-  ASSERT_TRUE(ba.solve(options).ok());
+  solveWindow(0.5, options, &ba);
   const double s = ba.varianceFactor(options);
   EXPECT_GT(s, 0.15);
   EXPECT_LT(s, 0.8);
-  testing::SyntheticWindowConfig model_noise = config;
-  model_noise.pixel_noise = 1.0;
-  const testing::SyntheticWindow w1 = testing::makeSyntheticWindow(model_noise);
   LocalBundleAdjuster ba1;
-  testing::loadWindow(w1, true, &ba1);
-  ASSERT_TRUE(ba1.solve(options).ok());
+  solveWindow(1.0, options, &ba1);
   EXPECT_NEAR(ba1.varianceFactor(options), 1.0, 0.2);
+}
+
+// Variance components: pixel noise at half the model (component 0.25), depth noise at the model
+// (1.0). Each part gets its own factor; the pooled factor lies in between and fits neither.
+TEST(VarianceFactor, LocalBaSeparatesPixelAndDepthComponents) {
+  const LocalBaOptions options;
+  LocalBundleAdjuster ba;
+  solveWindow(0.5, options, &ba);
+  const PointVarianceComponents c = ba.varianceComponents(options);
+  EXPECT_GT(c.redundancy, 100.0);
+  EXPECT_NEAR(c.pixel, 0.25, 0.06);
+  EXPECT_NEAR(c.depth, 1.0, 0.25);
+  const double pooled = ba.varianceFactor(options);
+  EXPECT_GT(pooled, c.pixel + 0.05);
+  EXPECT_LT(pooled, c.depth - 0.1);
+}
+
+// The stereo information split into pixel and disparity parts: the parts' chi2 add up to the whole
+// for the model's information, and scaling both parts by s is scaling the information by s.
+TEST(VarianceFactor, StereoInformationSplitsIntoPixelAndDepth) {
+  const CameraIntrinsics camera{525.0, 525.0, 319.5, 239.5, 525.0 * 0.08};
+  const NoiseModelOptions noise;
+  const Eigen::Matrix3d information = stereoPointInformation(noise, camera, 1, 2.5);
+  const Eigen::Vector3d e(0.7, -0.4, 1.9);
+  double pixel = 0, depth = 0;
+  splitStereoChi2(information, e, &pixel, &depth);
+  EXPECT_NEAR(pixel + depth, e.dot(information * e), 1e-9 * e.dot(information * e));
+  EXPECT_NEAR(pixel, (0.49 + 0.16) / std::pow(pixelSigma(noise, 1), 2), 1e-9);
+  EXPECT_TRUE(scaleStereoInformation(information, 3.0, 3.0).isApprox(3.0 * information, 1e-12));
+  // Depth scaled alone: the pixel part of the chi2 is unchanged, the depth part scaled.
+  const Eigen::Matrix3d depth_scaled = scaleStereoInformation(information, 1.0, 0.25);
+  double pixel2 = 0, depth2 = 0;
+  splitStereoChi2(depth_scaled, e, &pixel2, &depth2);
+  EXPECT_NEAR(pixel2, pixel, 1e-9 * pixel);
+  EXPECT_NEAR(depth2, 0.25 * depth, 1e-9 * depth);
 }
 
 }  // namespace

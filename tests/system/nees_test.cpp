@@ -16,10 +16,10 @@ struct Pooled {
   PooledNees relative, world, motion;
 };
 
-Pooled runSeeds(const SystemOptions& options, int seeds) {
+Pooled runSeeds(const SystemOptions& options, int seeds, const char* preset = "textured") {
   Pooled p;
   for (int seed = 1; seed <= seeds; ++seed) {
-    const NeesRun run = runSyntheticNees(kinectSynth("textured", uint64_t(seed), kFrames), options);
+    const NeesRun run = runSyntheticNees(kinectSynth(preset, uint64_t(seed), kFrames), options);
     EXPECT_TRUE(run.status.ok()) << run.status.message();
     EXPECT_EQ(run.frames_with_pose, std::size_t(kFrames)) << "seed " << seed;
     p.relative.add(run.nees.keyframe_relative);
@@ -58,6 +58,18 @@ TEST(NeesMonteCarlo, CalibratedCovariancesHoldTheirErrorsAndTheModelAsItIsDoesNo
   EXPECT_GT(p.relative.meanPerDof(), 2.0 * u.relative.meanPerDof());
   EXPECT_GT(p.world.meanPerDof(), 2.0 * u.world.meanPerDof());
   EXPECT_GT(p.motion.meanPerDof(), 2.0 * u.motion.meanPerDof());
+}
+
+// The line-rich office (long straight edges): with one pooled variance factor the line samples'
+// absorbed residuals pulled the factor down and the keyframe relative covariance was 2-4x
+// overconfident (seeds 1-2, 100 frames: NEES/dof 2.8; 10 seeds x 150 frames: 2.40). With the
+// variance components (docs/UNCERTAINTY.md) it is 1.10 here (1.25 over 10 seeds x 150 frames).
+TEST(NeesMonteCarlo, KeyframeCovarianceHoldsOnTheLineRichOffice) {
+  const Pooled p = runSeeds(SystemOptions{}, 2, "office_loop");
+  ASSERT_GE(p.relative.count, 6u);
+  std::printf("office_loop NEES/dof over 2 seeds: keyframe %.3f (n %zu)\n", p.relative.meanPerDof(), p.relative.count);
+  EXPECT_GT(p.relative.meanPerDof(), 0.5);
+  EXPECT_LT(p.relative.meanPerDof(), 1.8);
 }
 
 }  // namespace
