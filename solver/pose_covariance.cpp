@@ -29,15 +29,20 @@ Vector6d relativePoseError(const Eigen::Isometry3d& T_i_j_true, const Eigen::Iso
   return logSE3(T_i_j_true.inverse() * T_i_j_estimate);
 }
 
+bool poseSigmasWithin(const Matrix6d& covariance, double max_translation_sigma, double max_rotation_sigma) {
+  // SelfAdjointEigenSolver reads the lower triangle only.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> t(covariance.topLeftCorner<3, 3>(), Eigen::EigenvaluesOnly);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> r(covariance.bottomRightCorner<3, 3>(), Eigen::EigenvaluesOnly);
+  return t.info() == Eigen::Success && r.info() == Eigen::Success &&
+         t.eigenvalues().maxCoeff() <= max_translation_sigma * max_translation_sigma &&
+         r.eigenvalues().maxCoeff() <= max_rotation_sigma * max_rotation_sigma;
+}
+
 bool publishablePoseCovariance(const Matrix6d& covariance, double max_translation_sigma, double max_rotation_sigma) {
   if (!covariance.allFinite()) return false;
   const Matrix6d symmetric = 0.5 * (covariance + covariance.transpose());
   if (Eigen::LLT<Matrix6d>(symmetric).info() != Eigen::Success) return false;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> t(symmetric.topLeftCorner<3, 3>(), Eigen::EigenvaluesOnly);
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> r(symmetric.bottomRightCorner<3, 3>(), Eigen::EigenvaluesOnly);
-  return t.info() == Eigen::Success && r.info() == Eigen::Success &&
-         t.eigenvalues().maxCoeff() <= max_translation_sigma * max_translation_sigma &&
-         r.eigenvalues().maxCoeff() <= max_rotation_sigma * max_rotation_sigma;
+  return poseSigmasWithin(symmetric, max_translation_sigma, max_rotation_sigma);
 }
 
 double normalizedErrorSquared(const Vector6d& error, const Matrix6d& covariance) {

@@ -37,9 +37,12 @@ Matrix6d chainPoseCovariance(const Eigen::Isometry3d& T_i_cam_world, const Eigen
 // e = logSE3(T_i_j(true)^-1 T_i_j(estimate)). NEES = e^T Cov(e)^-1 e.
 Vector6d relativePoseError(const Eigen::Isometry3d& T_i_j_true, const Eigen::Isometry3d& T_i_j_estimate);
 
+// True when the largest translation and rotation sigmas of a [rho phi] covariance (square roots of
+// the largest eigenvalues of its two diagonal 3x3 blocks, read as symmetric) are within the bounds.
+bool poseSigmasWithin(const Matrix6d& covariance, double max_translation_sigma, double max_rotation_sigma);
+
 // True when `covariance` of a [rho phi] pose perturbation can be published: finite, symmetric
-// positive definite (Cholesky of its symmetric part), and its largest translation and rotation
-// sigmas (square roots of the largest eigenvalues of its two diagonal 3x3 blocks) within the bounds.
+// positive definite (Cholesky of its symmetric part), and poseSigmasWithin the bounds.
 bool publishablePoseCovariance(const Matrix6d& covariance, double max_translation_sigma, double max_rotation_sigma);
 
 // Normalised estimation error squared e^T C^-1 e (C symmetric positive definite); NaN when C is not.

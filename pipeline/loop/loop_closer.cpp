@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "solver/pose_covariance.h"
 #include "solver/rigid_fit.h"
 #include "solver/se3.h"
 #include "solver/se3_jacobians.h"
@@ -34,22 +35,6 @@ Matrix6d diagonalCovariance(double sigma_t, double sigma_r) {
 Matrix6d inverseSpd(const Matrix6d& m) {
   const Eigen::LDLT<Matrix6d> ldlt(m);
   return ldlt.solve(Matrix6d::Identity());
-}
-
-// True when the largest translation and rotation sigmas of a [rho phi] covariance are within the
-// bounds (the loop certainty gate, the odometry-edge sanity bound).
-bool sigmasWithin(const Matrix6d& covariance, double max_translation_sigma, double max_rotation_sigma) {
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> t(covariance.topLeftCorner<3, 3>(), Eigen::EigenvaluesOnly);
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> r(covariance.bottomRightCorner<3, 3>(), Eigen::EigenvaluesOnly);
-  return t.info() == Eigen::Success && r.info() == Eigen::Success &&
-         t.eigenvalues().maxCoeff() <= max_translation_sigma * max_translation_sigma &&
-         r.eigenvalues().maxCoeff() <= max_rotation_sigma * max_rotation_sigma;
-}
-
-bool finiteSpd(const Matrix6d& m) {
-  if (!m.allFinite()) return false;
-  const Eigen::LLT<Matrix6d> llt(0.5 * (m + m.transpose()));
-  return llt.info() == Eigen::Success;
 }
 
 double poseDistance(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
@@ -144,10 +129,10 @@ bool LoopCloser::finalPose(uint32_t keyframe_id, Eigen::Isometry3d* T_world_cam,
 Matrix6d LoopCloser::edgeCovariance(bool new_segment, const Matrix6d& covariance, bool covariance_valid) {
   if (new_segment)
     return diagonalCovariance(options_.segment_translation_sigma_m, options_.segment_rotation_sigma_rad);
-  if (covariance_valid && finiteSpd(covariance)) {
-    const Matrix6d symmetric = 0.5 * (covariance + covariance.transpose());
-    if (sigmasWithin(symmetric, options_.max_edge_translation_sigma_m, options_.max_edge_rotation_sigma_rad)) {
-      return symmetric +
+  if (covariance_valid) {
+    // Finite, SPD and within a physical bound (a degenerate BA marginal is refused, counted).
+    if (publishablePoseCovariance(covariance, options_.max_edge_translation_sigma_m, options_.max_edge_rotation_sigma_rad)) {
+      return 0.5 * (covariance + covariance.transpose()) +
              diagonalCovariance(options_.odometry_floor_translation_sigma_m, options_.odometry_floor_rotation_sigma_rad);
     }
     ++stats_.edge_covariances_refused;
@@ -463,7 +448,7 @@ bool LoopCloser::outputFit(Eigen::Isometry3d* T_mapping_graph) {
 }
 
 bool LoopCloser::certain(const Matrix6d& covariance) const {
-  return sigmasWithin(covariance, options_.max_loop_sigma_m, options_.max_loop_sigma_rad);
+  return poseSigmasWithin(covariance, options_.max_loop_sigma_m, options_.max_loop_sigma_rad);
 }
 
 bool LoopCloser::confirmNewestLoop() {
