@@ -275,7 +275,11 @@ bool LineSegmentDetector::regionToSegment(int size, float min_length, DetectedSe
   int x_min, x_max, y_min, y_max;
   regionBox(size, &x_min, &x_max, &y_min, &y_max);
   const double box_dx = x_max - x_min, box_dy = y_max - y_min;
-  if (std::sqrt(box_dx * box_dx + box_dy * box_dy) + 1.0 + 1e-6 < min_length) return false;  // margin: rounding
+  const double box_length = std::sqrt(box_dx * box_dx + box_dy * box_dy) + 1.0 + 1e-6;  // margin: rounding
+  if (box_length < min_length) return false;
+  // The same bound fails the thickness test below before the fit (~7 % of the fits on fr1/rpy):
+  // more than max_thickness_px pixels per unit of box_length >= length.
+  if (size > options_.max_thickness_px * box_length) return false;
   double sw = 0, cx = 0, cy = 0, gx = 0, gy = 0;
   for (int i = 0; i < size; ++i) {
     const int p = region_[i];
