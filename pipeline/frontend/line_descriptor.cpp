@@ -79,24 +79,27 @@ void computeLineDescriptor(const cv::Mat& image, const cv::Point2f& start, const
     }
   }
 
+  // The comparisons 4 at a time, as sign masks: 208 bits of 8 (one pair of bands: s = 0..7, so
+  // no group crosses a 64-bit word), then 8 groups of 6 within bands, all in the last word.
   int bit = 0;
-  auto put = [&](bool value) {
-    if (value) out.words[bit >> 6] |= 1ULL << (bit & 63);
-    ++bit;
-  };
   for (int i = 0; i < kBands; ++i) {
+    const cv::v_float32x4 lo_i = cv::v_load(band[i].data()), hi_i = cv::v_load(band[i].data() + 4);
     for (int j = i + 1; j < kBands && j - i <= 4; ++j) {
-      for (int s = 0; s < kStats; ++s) put(band[i][s] > band[j][s]);
+      const cv::v_float32x4 lo_j = cv::v_load(band[j].data()), hi_j = cv::v_load(band[j].data() + 4);
+      const uint64_t bits = static_cast<uint64_t>(cv::v_signmask(lo_i > lo_j) | cv::v_signmask(hi_i > hi_j) << 4);
+      out.words[bit >> 6] |= bits << (bit & 63);
+      bit += 8;
     }
   }
   for (int i = 0; i < kBands - 1; ++i) {  // 8 bands x 6 = 48 bits
-    const std::array<float, kStats>& b = band[i];
-    put(b[0] > b[1]);
-    put(b[4] > b[5]);
-    put(b[2] > b[3]);
-    put(b[6] > b[7]);
-    put(b[0] > b[4]);
-    put(b[1] > b[5]);
+    // (b0 > b1, b4 > b5, b2 > b3, b6 > b7), then (b0 > b4, b1 > b5).
+    const cv::v_float32x4 lo = cv::v_load(band[i].data()), hi = cv::v_load(band[i].data() + 4);
+    cv::v_float32x4 z0, z1;
+    cv::v_zip(lo, hi, z0, z1);  // (b0, b4, b1, b5), (b2, b6, b3, b7)
+    const int pairs = cv::v_signmask(cv::v_combine_low(z0, z1) > cv::v_combine_high(z0, z1));
+    const int halves = cv::v_signmask(lo > hi) & 3;
+    out.words[bit >> 6] |= static_cast<uint64_t>(pairs | halves << 4) << (bit & 63);
+    bit += 6;
   }
 }
 
