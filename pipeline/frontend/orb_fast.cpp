@@ -61,6 +61,9 @@ namespace {
 
 // True when some byte of `v` is nonzero. SSE2: one compare with zero and its sign mask; NEON
 // (aarch64): the across-vector maximum.
+// Keeps the compiler from reusing loads made before it (it may not assume memory unchanged).
+inline void compilerBarrier() { asm volatile("" ::: "memory"); }
+
 inline bool anyNonZero(const cv::v_uint8x16& v) {
 #if CV_NEON && defined(__aarch64__)
   return vmaxvq_u8(v.val) != 0;
@@ -69,26 +72,63 @@ inline bool anyNonZero(const cv::v_uint8x16& v) {
 #endif
 }
 
-// Max over the 16 cyclic arcs of 9 of the minimum of `diff` over the arc. With the circle
-// unrolled to e[0..23] (e[i] = diff[i % 16]) and cut into blocks [0..8], [9..17], [18..23], an
-// arc starting at k lies in one block (k = 0, 9) or is a suffix of one block and a prefix of
-// the next, so suffix and prefix minima give every arc: 42 minimums instead of 64 by doubling.
-inline cv::v_uint8x16 arcScore(const cv::v_uint8x16* diff, cv::v_uint8x16 score) {
-  auto e = [diff](int i) { return diff[i & 15]; };
-  cv::v_uint8x16 suffix_a[9], prefix_b[8], suffix_b[8], prefix_c[6];
-  suffix_a[8] = e(8);  // suffix_a[k] = min e[k..8]
-  for (int k = 7; k >= 0; --k) suffix_a[k] = cv::v_min(e(k), suffix_a[k + 1]);
-  prefix_b[0] = e(9);  // prefix_b[j] = min e[9..9 + j]
-  for (int j = 1; j < 8; ++j) prefix_b[j] = cv::v_min(prefix_b[j - 1], e(9 + j));
-  suffix_b[7] = e(17);  // suffix_b[j] = min e[10 + j..17]
-  for (int j = 6; j >= 0; --j) suffix_b[j] = cv::v_min(e(10 + j), suffix_b[j + 1]);
-  prefix_c[0] = e(18);  // prefix_c[j] = min e[18..18 + j]
-  for (int j = 1; j < 6; ++j) prefix_c[j] = cv::v_min(prefix_c[j - 1], e(18 + j));
-  score = cv::v_max(score, suffix_a[0]);  // the arc 0..8
-  for (int k = 1; k <= 8; ++k) score = cv::v_max(score, cv::v_min(suffix_a[k], prefix_b[k - 1]));
-  score = cv::v_max(score, cv::v_min(e(9), suffix_b[0]));  // the arc 9..17
-  for (int k = 10; k <= 15; ++k) score = cv::v_max(score, cv::v_min(suffix_b[k - 10], prefix_c[k - 10]));
-  return score;
+// Addresses of the 16 circle pixels of the block at `p` as base + stride x {0, 1, 2} + dx from
+// three bases (rows y - 3, y, y + 3): x86-64 addressing forms each with no arithmetic and no
+// table of offsets (a table of 16 offsets does not fit in registers and was reloaded per load).
+struct CircleAddress {
+  const uint8_t *up, *mid, *down;
+  std::ptrdiff_t stride;
+  CircleAddress(const uint8_t* p, std::ptrdiff_t s) : up(p - 3 * s), mid(p), down(p + 3 * s), stride(s) {}
+  const uint8_t* operator()(int k) const {
+    const int dy = kCircleY[k], dx = kCircleX[k];
+    if (dy < -1) return up + (dy + 3) * stride + dx;   // rows y - 3, y - 2
+    if (dy == -1) return up + 2 * stride + dx;
+    if (dy < 3) return mid + dy * stride + dx;         // rows y .. y + 2
+    return down + dx;
+  }
+  cv::v_uint8x16 load(int k) const { return cv::v_load((*this)(k)); }
+};
+
+// The segment test's score from the circle's raw values. With b_k = sat(I_k - c) and
+// e_k = sat(c - I_k), a pixel's score is the max over the 16 arcs of 9 of min(b) (bright side)
+// or min(e) (dark side). sat(x - c) grows with x, so the bright score is sat(M - c) with M the
+// max over the arcs of the arc's minimum of I; sat(c - x) shrinks, so the dark score is
+// sat(c - m) with m the min over the arcs of the arc's maximum. kBright picks which: `inner`
+// is taken along an arc, `outer` across the arcs. No differences per pixel are needed.
+//
+// With the circle unrolled to e[0..23] (e[i] = I_(i % 16)) and cut into blocks [0..8], [9..17],
+// [18..23], an arc starting at k lies in one block (k = 0, 9) or is a suffix of one block and a
+// prefix of the next, so suffix and prefix extremes give every arc: 42 `inner` operations instead
+// of 64 by doubling. The suffixes of a block are kept and the prefixes of the next one streamed;
+// each block's pixels are loaded again rather than kept (a compiler barrier stops the loads being
+// merged), so that no more than ~12 vectors are live: x86-64 has 16 vector registers, and with
+// all 16 kept GCC spilled ~70 of the ~170 instructions to the stack.
+template <bool kBright>
+inline cv::v_uint8x16 arcExtreme(const CircleAddress& at) {
+  auto inner = [](const cv::v_uint8x16& a, const cv::v_uint8x16& b) { return kBright ? cv::v_min(a, b) : cv::v_max(a, b); };
+  auto outer = [](const cv::v_uint8x16& a, const cv::v_uint8x16& b) { return kBright ? cv::v_max(a, b) : cv::v_min(a, b); };
+  auto e = [&at](int i) { return at.load(i & 15); };
+  cv::v_uint8x16 suffix[9];
+  suffix[8] = e(8);  // suffix[k] = inner e[k..8]
+  for (int k = 7; k >= 0; --k) suffix[k] = inner(e(k), suffix[k + 1]);
+  cv::v_uint8x16 best = suffix[0];  // the arc 0..8
+  compilerBarrier();
+  cv::v_uint8x16 prefix = e(9);  // inner e[9..k + 8] for the arc k = 1..8
+  for (int k = 1; k <= 8; ++k) {
+    best = outer(best, inner(suffix[k], prefix));
+    if (k < 8) prefix = inner(prefix, e(9 + k));
+  }
+  compilerBarrier();
+  suffix[7] = e(17);  // suffix[j] = inner e[10 + j..17]
+  for (int j = 6; j >= 0; --j) suffix[j] = inner(e(10 + j), suffix[j + 1]);
+  best = outer(best, inner(e(9), suffix[0]));  // the arc 9..17
+  compilerBarrier();
+  prefix = e(18);  // inner e[18..k + 8] for the arc k = 10..15
+  for (int k = 10; k <= 15; ++k) {
+    best = outer(best, inner(suffix[k - 10], prefix));
+    if (k < 15) prefix = inner(prefix, e(k + 9));
+  }
+  return best;
 }
 
 // A block of 16 pixels that passed the compass tests, for the second phase of a row.
@@ -106,20 +146,20 @@ struct CompassSurvivor {
 // (p4 or p12), on the same side; and, with the other four even pixels, one of each pair (0, 8),
 // (2, 10), (4, 12), (6, 14). Most blocks stop after the first pair. Returns false when no lane
 // can be a corner; else `bright` / `dark` are nonzero in the lanes that may be, per side.
-inline bool compassTest(const uint8_t* p, const std::ptrdiff_t* circle, const cv::v_uint8x16& t,
+inline bool compassTest(const CircleAddress& at, const cv::v_uint8x16& t,
                         cv::v_uint8x16& bright, cv::v_uint8x16& dark) {
-  const cv::v_uint8x16 c = cv::v_load(p);
+  const cv::v_uint8x16 c = cv::v_load(at.mid);
   const cv::v_uint8x16 c_hi = c + t, c_lo = c - t;  // saturating
-  const cv::v_uint8x16 n = cv::v_load(p + circle[0]), s = cv::v_load(p + circle[8]);
+  const cv::v_uint8x16 n = at.load(0), s = at.load(8);
   bright = cv::v_max(n, s) - c_hi;
   dark = c_lo - cv::v_min(n, s);
   if (!anyNonZero(bright | dark)) return false;
-  const cv::v_uint8x16 e = cv::v_load(p + circle[4]), w = cv::v_load(p + circle[12]);
+  const cv::v_uint8x16 e = at.load(4), w = at.load(12);
   bright = cv::v_min(bright, cv::v_max(e, w) - c_hi);
   dark = cv::v_min(dark, c_lo - cv::v_min(e, w));
   if (!anyNonZero(bright | dark)) return false;
-  const cv::v_uint8x16 ne = cv::v_load(p + circle[2]), sw = cv::v_load(p + circle[10]);
-  const cv::v_uint8x16 se = cv::v_load(p + circle[6]), nw = cv::v_load(p + circle[14]);
+  const cv::v_uint8x16 ne = at.load(2), sw = at.load(10);
+  const cv::v_uint8x16 se = at.load(6), nw = at.load(14);
   bright = cv::v_min(bright, cv::v_min(cv::v_max(ne, sw) - c_hi, cv::v_max(se, nw) - c_hi));
   dark = cv::v_min(dark, cv::v_min(c_lo - cv::v_min(ne, sw), c_lo - cv::v_min(se, nw)));
   return anyNonZero(bright | dark);
@@ -135,10 +175,7 @@ void FastDetector::scan(int threshold, int x0, int y0, int x1, int y1) {
   const int x_end = std::min(x1, image.cols - border_), y_end = std::min(y1, image.rows - border_);
   threshold = std::clamp(threshold, 1, 254);
 
-  // Pointer-sized offsets: with int ones GCC re-extended all 16 to 64 bits at every row (about a
-  // tenth of the scan, as the low-threshold pass visits many short cell rows).
-  std::ptrdiff_t circle[16];
-  for (int k = 0; k < 16; ++k) circle[k] = std::ptrdiff_t(kCircleY[k]) * stride + kCircleX[k];
+  const std::ptrdiff_t row_step = stride;
   // Unsigned byte comparisons as signed ones on values with the top bit flipped (SSE2 only has
   // signed byte compares): a > b  <=>  (a ^ 0x80) > (b ^ 0x80).
   const cv::v_uint8x16 t = cv::v_setall_u8(static_cast<uint8_t>(threshold));
@@ -166,7 +203,7 @@ void FastDetector::scan(int threshold, int x0, int y0, int x1, int y1) {
       int num_survivors = 0;
       for (; x + 16 <= x_end && num_survivors < kMaxBlocks; x += 16) {
         CompassSurvivor& s = survivors[num_survivors];
-        if (compassTest(row + x, circle, t, s.bright, s.dark)) {
+        if (compassTest(CircleAddress(row + x, row_step), t, s.bright, s.dark)) {
           s.bx = x;
           s.first_lane = 0;
           ++num_survivors;
@@ -174,7 +211,7 @@ void FastDetector::scan(int threshold, int x0, int y0, int x1, int y1) {
       }
       if (x < x_end && num_survivors < kMaxBlocks) {  // the row's last block, moved back
         CompassSurvivor& s = survivors[num_survivors];
-        if (compassTest(row + x_end - 16, circle, t, s.bright, s.dark)) {
+        if (compassTest(CircleAddress(row + x_end - 16, row_step), t, s.bright, s.dark)) {
           s.bx = x_end - 16;
           s.first_lane = x - (x_end - 16);
           ++num_survivors;
@@ -183,8 +220,8 @@ void FastDetector::scan(int threshold, int x0, int y0, int x1, int y1) {
       }
       for (int i = 0; i < num_survivors; ++i) {
         const CompassSurvivor& s = survivors[i];
-        const uint8_t* p = row + s.bx;
-        const cv::v_uint8x16 c = cv::v_load(p);
+        const CircleAddress at(row + s.bx, row_step);
+        const cv::v_uint8x16 c = cv::v_load(at.mid);
         const cv::v_int8x16 hi = flip(c + t), lo = flip(c - t);
         // Second filter, the full count: an arc of 9 needs >= 9 of the 16 pixels on one side. It
         // also tells which sides can still have a corner, so only those get scored below.
@@ -192,12 +229,14 @@ void FastDetector::scan(int threshold, int x0, int y0, int x1, int y1) {
         cv::v_int8x16 maybe_bright = cv::v_setzero_s8(), maybe_dark = cv::v_setzero_s8();
         if (anyNonZero(s.bright)) {
           cv::v_int8x16 bright = cv::v_setzero_s8();
-          for (int k = 0; k < 16; ++k) bright -= (flip(cv::v_load(p + circle[k])) > hi);  // true is -1
+#pragma GCC unroll 16
+          for (int k = 0; k < 16; ++k) bright -= (flip(at.load(k)) > hi);  // true is -1
           maybe_bright = (bright >= nine) & cv::v_reinterpret_as_s8(s.bright != zero);
         }
         if (anyNonZero(s.dark)) {
           cv::v_int8x16 dark = cv::v_setzero_s8();
-          for (int k = 0; k < 16; ++k) dark -= (flip(cv::v_load(p + circle[k])) < lo);
+#pragma GCC unroll 16
+          for (int k = 0; k < 16; ++k) dark -= (flip(at.load(k)) < lo);
           maybe_dark = (dark >= nine) & cv::v_reinterpret_as_s8(s.dark != zero);
         }
         const bool any_bright = cv::v_check_any(maybe_bright), any_dark = cv::v_check_any(maybe_dark);
@@ -208,15 +247,8 @@ void FastDetector::scan(int threshold, int x0, int y0, int x1, int y1) {
         // of 9 of 16 cannot be bright and dark at once, so a corner's score is that of the side
         // that passed the count: a side no lane can pass is skipped without changing any score.
         cv::v_uint8x16 score = cv::v_setzero_u8();
-        cv::v_uint8x16 diff[16];
-        if (any_bright) {
-          for (int k = 0; k < 16; ++k) diff[k] = cv::v_load(p + circle[k]) - c;
-          score = arcScore(diff, score);
-        }
-        if (any_dark) {
-          for (int k = 0; k < 16; ++k) diff[k] = c - cv::v_load(p + circle[k]);
-          score = arcScore(diff, score);
-        }
+        if (any_bright) score = arcExtreme<true>(at) - c;  // saturating
+        if (any_dark) score = cv::v_max(score, c - arcExtreme<false>(at));
         const cv::v_uint8x16 candidates = cv::v_reinterpret_as_u8(maybe_bright | maybe_dark);
         int mask = cv::v_signmask((score > t) & candidates) & (0xFFFF << s.first_lane);
         if (!mask) continue;
