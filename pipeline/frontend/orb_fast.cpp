@@ -59,11 +59,29 @@ void FastDetector::begin(const cv::Mat& image, int border) {
 
 namespace {
 
-// True when some byte of `v` is nonzero. SSE2: one compare with zero and its sign mask; NEON
-// (aarch64): the across-vector maximum.
+// a <= b and a >= b on unsigned bytes, 0xFF where true. SSE2 has only signed byte compares, and
+// OpenCV's unsigned ones flip both sides' top bits first; max(a, b) == b is two instructions.
+// NEON compares unsigned bytes in one.
+inline cv::v_uint8x16 atMost(const cv::v_uint8x16& a, const cv::v_uint8x16& b) {
+#if CV_NEON
+  return a <= b;
+#else
+  return cv::v_max(a, b) == b;
+#endif
+}
+inline cv::v_uint8x16 atLeast(const cv::v_uint8x16& a, const cv::v_uint8x16& b) {
+#if CV_NEON
+  return a >= b;
+#else
+  return cv::v_min(a, b) == b;
+#endif
+}
+
 // Keeps the compiler from reusing loads made before it (it may not assume memory unchanged).
 inline void compilerBarrier() { asm volatile("" ::: "memory"); }
 
+// True when some byte of `v` is nonzero. SSE2: one compare with zero and its sign mask; NEON
+// (aarch64): the across-vector maximum.
 inline bool anyNonZero(const cv::v_uint8x16& v) {
 #if CV_NEON && defined(__aarch64__)
   return vmaxvq_u8(v.val) != 0;
@@ -176,12 +194,8 @@ void FastDetector::scan(int threshold, int x0, int y0, int x1, int y1) {
   threshold = std::clamp(threshold, 1, 254);
 
   const std::ptrdiff_t row_step = stride;
-  // Unsigned byte comparisons as signed ones on values with the top bit flipped (SSE2 only has
-  // signed byte compares): a > b  <=>  (a ^ 0x80) > (b ^ 0x80).
   const cv::v_uint8x16 t = cv::v_setall_u8(static_cast<uint8_t>(threshold));
-  const cv::v_int8x16 sign = cv::v_setall_s8(-128);
-  auto flip = [&sign](const cv::v_uint8x16& v) { return cv::v_reinterpret_as_s8(v) ^ sign; };
-  const cv::v_int8x16 nine = cv::v_setall_s8(9);
+  const cv::v_uint8x16 eight = cv::v_setall_u8(8);
   const cv::v_uint8x16 zero = cv::v_setzero_u8();
   auto record = [&](uint8_t* score_row, int x, int y, int score) {
     if (score <= threshold) return;
@@ -201,44 +215,41 @@ void FastDetector::scan(int threshold, int x0, int y0, int x1, int y1) {
     uint8_t* score_row = score_.ptr<uint8_t>(y);
     for (int x = x0; blocks && x < x_end;) {
       int num_survivors = 0;
+      // The tests write into registers; only survivors are stored (storing every block's result
+      // into the buffer cost ~4 instructions a block).
+      cv::v_uint8x16 bright, dark;
+      auto keep = [&](int bx, int first_lane) {
+        survivors[num_survivors++] = CompassSurvivor{bright, dark, bx, first_lane};
+      };
       for (; x + 16 <= x_end && num_survivors < kMaxBlocks; x += 16) {
-        CompassSurvivor& s = survivors[num_survivors];
-        if (compassTest(CircleAddress(row + x, row_step), t, s.bright, s.dark)) {
-          s.bx = x;
-          s.first_lane = 0;
-          ++num_survivors;
-        }
+        if (compassTest(CircleAddress(row + x, row_step), t, bright, dark)) keep(x, 0);
       }
       if (x < x_end && num_survivors < kMaxBlocks) {  // the row's last block, moved back
-        CompassSurvivor& s = survivors[num_survivors];
-        if (compassTest(CircleAddress(row + x_end - 16, row_step), t, s.bright, s.dark)) {
-          s.bx = x_end - 16;
-          s.first_lane = x - (x_end - 16);
-          ++num_survivors;
-        }
+        if (compassTest(CircleAddress(row + x_end - 16, row_step), t, bright, dark)) keep(x_end - 16, x - (x_end - 16));
         x = x_end;
       }
       for (int i = 0; i < num_survivors; ++i) {
         const CompassSurvivor& s = survivors[i];
         const CircleAddress at(row + s.bx, row_step);
         const cv::v_uint8x16 c = cv::v_load(at.mid);
-        const cv::v_int8x16 hi = flip(c + t), lo = flip(c - t);
-        // Second filter, the full count: an arc of 9 needs >= 9 of the 16 pixels on one side. It
-        // also tells which sides can still have a corner, so only those get scored below.
-        // A side no lane passed the compass tests on is not counted.
+        const cv::v_uint8x16 c_hi = c + t, c_lo = c - t;  // saturating
+        // Second filter, the full count: an arc of 9 needs >= 9 of the 16 pixels on one side, i.e.
+        // at most 7 not on it. It also tells which sides can still have a corner, so only those
+        // get scored below; a side no lane passed the compass tests on is not counted.
         cv::v_int8x16 maybe_bright = cv::v_setzero_s8(), maybe_dark = cv::v_setzero_s8();
         if (anyNonZero(s.bright)) {
-          cv::v_int8x16 bright = cv::v_setzero_s8();
+          cv::v_uint8x16 not_bright = zero;
 #pragma GCC unroll 16
-          for (int k = 0; k < 16; ++k) bright -= (flip(at.load(k)) > hi);  // true is -1
-          maybe_bright = (bright >= nine) & cv::v_reinterpret_as_s8(s.bright != zero);
+          for (int k = 0; k < 16; ++k) not_bright = cv::v_sub_wrap(not_bright, atMost(at.load(k), c_hi));  // true: 0xFF = -1
+          maybe_bright = cv::v_reinterpret_as_s8((not_bright < eight) & (s.bright != zero));
         }
         if (anyNonZero(s.dark)) {
-          cv::v_int8x16 dark = cv::v_setzero_s8();
+          cv::v_uint8x16 not_dark = zero;
 #pragma GCC unroll 16
-          for (int k = 0; k < 16; ++k) dark -= (flip(at.load(k)) < lo);
-          maybe_dark = (dark >= nine) & cv::v_reinterpret_as_s8(s.dark != zero);
+          for (int k = 0; k < 16; ++k) not_dark = cv::v_sub_wrap(not_dark, atLeast(at.load(k), c_lo));
+          maybe_dark = cv::v_reinterpret_as_s8((not_dark < eight) & (s.dark != zero));
         }
+        compilerBarrier();  // the score loads the pixels again rather than keep 16 of them (spills)
         const bool any_bright = cv::v_check_any(maybe_bright), any_dark = cv::v_check_any(maybe_dark);
         if (!any_bright && !any_dark) continue;
         // Score in saturating u8 arithmetic: with b_k = sat(I_k - c) and e_k = sat(c - I_k), the
