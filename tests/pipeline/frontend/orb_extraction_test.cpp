@@ -127,6 +127,34 @@ TEST(FastDetector, VectorScanEqualsScalarReferenceForEveryThreshold) {
   EXPECT_GT(corners_checked, 20000);  // the images must exercise the detector at many thresholds
 }
 
+// Rows wider than the scan's buffer of blocks that passed the compass tests (64 blocks of 16):
+// a row of noise then passes it in several rounds, which must keep raster order.
+TEST(FastDetector, VectorScanOfRowsWiderThanItsBlockBuffer) {
+  const int width = 16 * 64 * 2 + 37, height = 10;
+  cv::Mat img(height, width, CV_8UC1);
+  cv::RNG rng(2222);
+  rng.fill(img, cv::RNG::UNIFORM, 0, 256);
+  FastDetector fast(width, height, 40000);
+  for (const int threshold : {1, 10, 40}) {
+    fast.begin(img, 3);
+    fast.scan(threshold, 0, 0, width, height);
+    int expected = 0;
+    for (int y = 3; y < height - 3; ++y) {
+      for (int x = 3; x < width - 3; ++x) {
+        const int score = fastScore(img.ptr<uint8_t>(y) + x, static_cast<int>(img.step[0]));
+        if (score <= threshold) continue;
+        ASSERT_LT(expected, fast.numRaw()) << "threshold " << threshold;
+        const FastCorner& got = fast.rawCorners()[expected++];
+        ASSERT_TRUE(got.x == x && got.y == y && got.score == score)
+            << "threshold " << threshold << ": got " << got.x << "," << got.y << " score " << int(got.score)
+            << ", expected " << x << "," << y << " score " << score;
+      }
+    }
+    EXPECT_EQ(fast.numRaw(), expected) << "threshold " << threshold;
+    EXPECT_GT(expected, 1000) << "threshold " << threshold;  // most blocks pass the compass tests
+  }
+}
+
 TEST(OrbExtraction, RealFrameGivesAboutOneThousandUndistortedKeypoints) {
   RgbdImage frame;
   if (!test::loadTumRpyFrame(10, &frame)) GTEST_SKIP() << "TUM fr1/rpy not found under " << test::tumRpyDir();
