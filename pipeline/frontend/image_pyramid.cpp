@@ -146,11 +146,42 @@ PLUMB_BYTE_BLUR_INLINE int blurBlocks(const uint8_t* const* rows, int begin, int
   return begin;
 }
 
+// The horizontal pass's weights for blurRowEvenOdd(): the adjacent taps (k0, k1), (k2, k3),
+// (k4, k5), (k6, 0) as byte pairs.
+struct AdjacentPairWeights {
+  __m128i pair[4];
+  explicit AdjacentPairWeights(const std::array<int, 7>& k)
+      : pair{_mm_set1_epi16(int16_t(k[0] | k[1] << 8)), _mm_set1_epi16(int16_t(k[2] | k[3] << 8)),
+             _mm_set1_epi16(int16_t(k[4] | k[5] << 8)), _mm_set1_epi16(int16_t(k[6]))} {}
+};
+
+// 16 horizontal outputs at d[0..15] from the byte row t (read t[-3 .. 19]) without any byte
+// interleaving: pmaddubsw on a load at t - 3 multiplies the adjacent pairs (t[2j - 3], t[2j - 2])
+// by (k0, k1), the first two taps of even output 2j; loads at t - 1, t + 1 and t + 3 give its
+// other taps, and the same four loads one byte later those of odd output 2j + 1. Each pair sum
+// is <= 255 * 103 (no saturation) and the total is the portable path's integer sum. The even
+// results go to the low byte of each 16-bit lane, the odd ones to the high byte: 8 loads and 8
+// multiply-adds for 16 outputs, where interleaving the shifted rows took 7 loads, 14 unpacks and
+// 8 multiply-adds.
+PLUMB_BYTE_BLUR_INLINE void blurRowEvenOdd(const uint8_t* t, const AdjacentPairWeights& w, __m128i round,
+                                           uint8_t* d) {
+  auto at = [t](int offset) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(t + offset)); };
+  __m128i even = _mm_add_epi16(_mm_maddubs_epi16(at(-3), w.pair[0]), _mm_maddubs_epi16(at(-1), w.pair[1]));
+  even = _mm_add_epi16(even, _mm_add_epi16(_mm_maddubs_epi16(at(1), w.pair[2]), _mm_maddubs_epi16(at(3), w.pair[3])));
+  __m128i odd = _mm_add_epi16(_mm_maddubs_epi16(at(-2), w.pair[0]), _mm_maddubs_epi16(at(0), w.pair[1]));
+  odd = _mm_add_epi16(odd, _mm_add_epi16(_mm_maddubs_epi16(at(2), w.pair[2]), _mm_maddubs_epi16(at(4), w.pair[3])));
+  even = _mm_srli_epi16(_mm_add_epi16(even, round), 8);
+  odd = _mm_srli_epi16(_mm_add_epi16(odd, round), 8);
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(d), _mm_or_si128(even, _mm_slli_epi16(odd, 8)));
+}
+
 PLUMB_PYRAMID_SHUFFLE_TARGET void blurByteMultiplyAdd(const cv::Mat& src, cv::Mat& dst, int x0, int y0, int x1,
                                                       int y1, const std::array<int, 7>& kernel, uint8_t* t) {
-  // t: the byte row, valid on [-3, w + 3) after the edge mirroring below.
+  // t: the byte row, valid on [-3, w + 3) after the edge mirroring below (t[w + 3], read by the
+  // last 16-wide horizontal block with weight 0, is padding).
   const int w = src.cols, h = src.rows;
   const ByteWeights weights(kernel);
+  const AdjacentPairWeights adjacent(kernel);
   const int vx0 = std::max(x0 - 3, 0), vx1 = std::min(x1 + 3, w);
   const uint8_t* columns[7];  // the horizontal pass: t shifted by -3 .. 3
   for (int i = 0; i < 7; ++i) columns[i] = t + i - 3;
@@ -160,6 +191,14 @@ PLUMB_PYRAMID_SHUFFLE_TARGET void blurByteMultiplyAdd(const cv::Mat& src, cv::Ma
     blurVerticalScalar(r, kernel.data(), blurBlocks(r, vx0, vx1, weights, t), vx1, t);
     mirrorEdges(t, w, x0, x1);
     uint8_t* d = dst.ptr<uint8_t>(y);
+    if (x1 - x0 >= 16) {  // blocks of 16, the last one moved back to end at x1
+      for (int x = x0; x < x1;) {
+        const int bx = std::min(x, x1 - 16);
+        blurRowEvenOdd(t + bx, adjacent, weights.round, d + bx);
+        x = bx + 16;
+      }
+      continue;
+    }
     blurHorizontalScalar(t, kernel.data(), blurBlocks(columns, x0, x1, weights, d), x1, d);
   }
 }
@@ -178,7 +217,8 @@ ImagePyramid::ImagePyramid(int width, int height, int num_levels, float scale_fa
     total_rows += sizes[i].height;
   }
   row_filtered_.create(1, width + 6, CV_16UC1);  // one padded row
-  row_filtered_bytes_.create(1, width + 6, CV_8UC1);
+  row_filtered_bytes_.create(1, width + 7, CV_8UC1);  // 3 px each side, 1 of padding (blurByteMultiplyAdd)
+  row_filtered_bytes_.setTo(0);
   high_row_.create(1, width + 8, CV_16SC1);  // + padding: see downsample()
   low_row_.create(1, width + 8, CV_16SC1);
   high_row_.setTo(0);
@@ -256,23 +296,32 @@ namespace {
 // The horizontal pass of downsample() on whole blocks of 8 outputs, gathering the (x0, x0 + 1)
 // pairs by byte shuffles; the same integer arithmetic, so the same bytes. Returns the first
 // output column it did not write.
+// The 4 outputs of group g. Called through a macro, not a lambda: a lambda does not carry the
+// SSSE3 target, and GCC then calls shuffleBytes() instead of inlining it.
+PLUMB_PYRAMID_SHUFFLE_TARGET inline __attribute__((always_inline)) cv::v_int32x4 shuffledQuad(
+    const int16_t* high, const int16_t* low, const int32_t* bases, const uint8_t* shuffles, const int32_t* weights,
+    int g) {
+  const cv::v_int16x8 high_pairs = shuffleBytes(high + bases[g], shuffles + 16 * g);
+  const cv::v_int16x8 low_pairs = shuffleBytes(low + bases[g], shuffles + 16 * g);
+  const cv::v_int16x8 w = cv::v_reinterpret_as_s16(cv::v_load(weights + 4 * g));
+  return ((cv::v_dotprod(high_pairs, w) << 10) + cv::v_dotprod(low_pairs, w) + cv::v_setall_s32(1 << 21)) >> 22;
+}
+
 PLUMB_PYRAMID_SHUFFLE_TARGET int horizontalShuffled(const int16_t* high, const int16_t* low, const int32_t* bases,
                                                     const uint8_t* shuffles, const int32_t* weights, int cols,
                                                     uint8_t* d) {
-  const cv::v_int32x4 round = cv::v_setall_s32(1 << 21);
+  // 16 outputs (4 groups) a step, one pack to bytes and one store; the group tables are walked by
+  // pointer so that the loop computes no indices. Then one block of 8.
+#define PLUMB_QUAD(g) shuffledQuad(high, low, bases, shuffles, weights, g)
   int xd = 0;
-  for (int g = 0; xd + 8 <= cols; xd += 8, g += 2) {
-    cv::v_int32x4 sums[2];
-    for (int h = 0; h < 2; ++h) {
-      const int base = bases[g + h];
-      const uint8_t* shuffle = shuffles + 16 * (g + h);
-      const cv::v_int16x8 high_pairs = shuffleBytes(high + base, shuffle);
-      const cv::v_int16x8 low_pairs = shuffleBytes(low + base, shuffle);
-      const cv::v_int16x8 w = cv::v_reinterpret_as_s16(cv::v_load(weights + xd + 4 * h));
-      sums[h] = ((cv::v_dotprod(high_pairs, w) << 10) + cv::v_dotprod(low_pairs, w) + round) >> 22;
-    }
-    cv::v_pack_u_store(d + xd, cv::v_pack(sums[0], sums[1]));
+  for (; xd + 16 <= cols; xd += 16, bases += 4, shuffles += 64, weights += 16) {
+    cv::v_store(d + xd, cv::v_pack_u(cv::v_pack(PLUMB_QUAD(0), PLUMB_QUAD(1)), cv::v_pack(PLUMB_QUAD(2), PLUMB_QUAD(3))));
   }
+  if (xd + 8 <= cols) {
+    cv::v_pack_u_store(d + xd, cv::v_pack(PLUMB_QUAD(0), PLUMB_QUAD(1)));
+    xd += 8;
+  }
+#undef PLUMB_QUAD
   return xd;
 }
 
@@ -323,6 +372,21 @@ void ImagePyramid::downsample(int level) {
     const int w1 = ty.weight, w0 = one - w1;
     const cv::v_int16x8 weights = cv::v_reinterpret_as_s16(cv::v_setall_s32(w0 | (w1 << 16)));
     int x = 0;
+    // 16 pixels a step: the two rows' bytes are interleaved before widening (one zip of bytes
+    // instead of one per 8 pixels of 16-bit lanes), then the same multiply-adds.
+    for (; x + 16 <= src.cols; x += 16) {
+      cv::v_uint8x16 ab_lo, ab_hi;
+      cv::v_zip(cv::v_load(s0 + x), cv::v_load(s1 + x), ab_lo, ab_hi);  // (a0, b0, a1, b1, ...)
+      cv::v_uint16x8 p[4];
+      cv::v_expand(ab_lo, p[0], p[1]);
+      cv::v_expand(ab_hi, p[2], p[3]);
+      cv::v_int32x4 v[4];
+      for (int i = 0; i < 4; ++i) v[i] = cv::v_dotprod(cv::v_reinterpret_as_s16(p[i]), weights);
+      cv::v_store(high + x, cv::v_pack(v[0] >> 10, v[1] >> 10));
+      cv::v_store(high + x + 8, cv::v_pack(v[2] >> 10, v[3] >> 10));
+      cv::v_store(low + x, cv::v_pack(v[0] & low_mask, v[1] & low_mask));
+      cv::v_store(low + x + 8, cv::v_pack(v[2] & low_mask, v[3] & low_mask));
+    }
     for (; x + 8 <= src.cols; x += 8) {
       const cv::v_int16x8 a = cv::v_reinterpret_as_s16(cv::v_load_expand(s0 + x));
       const cv::v_int16x8 b = cv::v_reinterpret_as_s16(cv::v_load_expand(s1 + x));
