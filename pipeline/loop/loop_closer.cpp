@@ -261,6 +261,8 @@ void LoopCloser::detect(const LoopKeyframe& query_record, int query_position) {
     entry.point_inliers = m.refined_inliers;
     entry.line_matches = m.line_matches;
     entry.line_sample_inliers = m.line_inliers;
+    entry.unreliable_features = m.unreliable_features;
+    entry.max_leverage = m.max_leverage;
     entry.correction_m = entry.correction_deg = entry.chi2 = std::numeric_limits<double>::quiet_NaN();
     const Matrix6d covariance =
         0.5 * (m.covariance + m.covariance.transpose()) +
