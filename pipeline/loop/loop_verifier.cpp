@@ -54,6 +54,7 @@ struct LoopVerifier::Scratch {
   std::array<uint8_t, kMaxLoopLines * kMaxLineSamples> line_of_sample{};
   std::array<int16_t, kMaxLoopPoints> feature_parent{};
   std::array<bool, kMaxLoopPoints> keep{};
+  std::array<Eigen::Vector2d, kMaxLoopPoints> candidate_px{};
   std::array<Matrix6d, kMaxLoopPoints> feature_information{};
   std::array<Matrix6d, kMaxLoopLines> line_information{};
 };
@@ -126,12 +127,12 @@ double LoopVerifier::weakestFeature(const PoseResult& pose, int num_points, int 
     s.feature_information[u].setZero();
     if (!s.pose_point_inlier[u]) continue;
     const Eigen::Vector2d q_i = s.pose_points[u].z.head<2>();
-    const Eigen::Vector2d c_i = projectToPixel(camera_, s.pose_points[u].P_world);
+    s.candidate_px[u] = projectToPixel(camera_, s.pose_points[u].P_world);
     for (int j = 0; j < i; ++j) {
       const std::size_t v = std::size_t(j);
       if (!s.pose_point_inlier[v]) continue;
       if ((q_i - s.pose_points[v].z.head<2>()).squaredNorm() > r2 &&
-          (c_i - projectToPixel(camera_, s.pose_points[v].P_world)).squaredNorm() > r2)
+          (s.candidate_px[u] - s.candidate_px[v]).squaredNorm() > r2)
         continue;
       const int a = root(i), b = root(j);
       if (a != b) s.feature_parent[std::size_t(std::max(a, b))] = int16_t(std::min(a, b));
