@@ -84,7 +84,7 @@ std::size_t LoopCloser::memoryBytesFor(const LoopCloserOptions& o) {
   return sizeof(LoopCloser) + slots * (sizeof(LoopCandidate) + sizeof(Node) + 2 * sizeof(int)) +
          std::size_t(o.max_loop_edges) * sizeof(LoopEdge) +
          KeyframeDatabase::memoryBytesFor(databaseOptions(o)) + graph + sparse + sizeof(LoopVerifier) +
-         110 * 1024 +  // verifier scratch (~105 KB)
+         LoopVerifier::scratchBytes() +
          slots * sizeof(Eigen::Isometry3d) +  // poses before an optimisation (rollback)
          2 * slots * sizeof(Eigen::Vector3d) +  // the real-time anchor's fit (outputFit)
          LoopContextCheck::scratchBytes() +

@@ -49,14 +49,14 @@ struct LoopVerifier::Scratch {
   std::array<bool, kMaxLoopPoints> pose_point_inlier{};
   std::array<PoseLineObservation, kMaxLoopLines * kMaxLineSamples> pose_lines{};
   std::array<bool, kMaxLoopLines * kMaxLineSamples> pose_line_inlier{};
-  // Reliability (weakestFeature): the line each sample belongs to, the union-find parent of each
-  // point observation (its feature), and each feature's and line's information.
+  // Reliability (weakestFeature): the line each sample belongs to (a line's samples are
+  // contiguous), the union-find parent and root of each point observation (its feature).
   std::array<uint8_t, kMaxLoopLines * kMaxLineSamples> line_of_sample{};
   std::array<int16_t, kMaxLoopPoints> feature_parent{};
   std::array<bool, kMaxLoopPoints> keep{};
   std::array<Eigen::Vector2d, kMaxLoopPoints> candidate_px{};
-  std::array<Matrix6d, kMaxLoopPoints> feature_information{};
-  std::array<Matrix6d, kMaxLoopLines> line_information{};
+  std::array<int16_t, kMaxLoopPoints> feature_root{};
+  std::array<int16_t, kMaxLoopPoints> by_feature{};  // inliers ordered by (feature, index)
 };
 static_assert(kMaxLoopLines <= 256, "line_of_sample is a uint8_t");
 static_assert(kMaxLoopPoints <= 32767, "feature_parent is an int16_t");
@@ -77,6 +77,8 @@ LoopVerifier::LoopVerifier(const CameraIntrinsics& camera, const NoiseModelOptio
     : camera_(camera), noise_(noise), options_(options), s_(std::make_unique<Scratch>()) {}
 
 LoopVerifier::~LoopVerifier() = default;
+
+std::size_t LoopVerifier::scratchBytes() { return sizeof(Scratch); }
 
 bool LoopVerifier::lineAgrees(const LoopLine& query_line, const Eigen::Vector3f* candidate_samples,
                               std::size_t count, const Eigen::Isometry3d& T_query_candidate) const {
@@ -124,7 +126,6 @@ double LoopVerifier::weakestFeature(const PoseResult& pose, int num_points, int 
   for (int i = 0; i < num_points; ++i) {
     const std::size_t u = std::size_t(i);
     s.feature_parent[u] = int16_t(i);
-    s.feature_information[u].setZero();
     if (!s.pose_point_inlier[u]) continue;
     const Eigen::Vector2d q_i = s.pose_points[u].z.head<2>();
     s.candidate_px[u] = projectToPixel(camera_, s.pose_points[u].P_world);
@@ -138,35 +139,42 @@ double LoopVerifier::weakestFeature(const PoseResult& pose, int num_points, int 
       if (a != b) s.feature_parent[std::size_t(std::max(a, b))] = int16_t(std::min(a, b));
     }
   }
+  // Each feature's information summed over its inliers in index order, one feature after the
+  // other (no per-feature storage).
+  int inliers = 0;
   for (int i = 0; i < num_points; ++i) {
     if (!s.pose_point_inlier[std::size_t(i)]) continue;
-    s.feature_information[std::size_t(root(i))] +=
-        poseInformation(camera_, pose.T_cam_world, s.pose_points[std::size_t(i)], pose_options);
+    s.feature_root[std::size_t(i)] = int16_t(root(i));
+    s.by_feature[std::size_t(inliers++)] = int16_t(i);
   }
+  std::sort(s.by_feature.begin(), s.by_feature.begin() + inliers, [&s](int16_t a, int16_t b) {
+    const int16_t ra = s.feature_root[std::size_t(a)], rb = s.feature_root[std::size_t(b)];
+    return ra != rb ? ra < rb : a < b;
+  });
   double worst = 0;
   *feature = 0;
-  for (int i = 0; i < num_points; ++i) {
-    if (!s.pose_point_inlier[std::size_t(i)] || root(i) != i) continue;
-    const double leverage = groupLeverage(pose.covariance, s.feature_information[std::size_t(i)]);
+  auto consider = [&](const Matrix6d& information, int id) {
+    const double leverage = groupLeverage(pose.covariance, information);
     if (leverage > worst) {
       worst = leverage;
-      *feature = i;
+      *feature = id;
     }
+  };
+  Matrix6d information = Matrix6d::Zero();
+  for (int k = 0; k < inliers; ++k) {
+    const std::size_t i = std::size_t(s.by_feature[std::size_t(k)]);
+    information += poseInformation(camera_, pose.T_cam_world, s.pose_points[i], pose_options);
+    const bool last = k + 1 == inliers || s.feature_root[std::size_t(s.by_feature[std::size_t(k + 1)])] != s.feature_root[i];
+    if (!last) continue;
+    consider(information, s.feature_root[i]);
+    information.setZero();
   }
-  int lines = 0;
-  for (int k = 0; k < num_lines; ++k) lines = std::max(lines, int(s.line_of_sample[std::size_t(k)]) + 1);
-  for (int l = 0; l < lines; ++l) s.line_information[std::size_t(l)].setZero();
   for (int k = 0; k < num_lines; ++k) {
-    if (!s.pose_line_inlier[std::size_t(k)]) continue;
-    s.line_information[s.line_of_sample[std::size_t(k)]] +=
-        poseInformation(camera_, pose.T_cam_world, s.pose_lines[std::size_t(k)], pose_options);
-  }
-  for (int l = 0; l < lines; ++l) {
-    const double leverage = groupLeverage(pose.covariance, s.line_information[std::size_t(l)]);
-    if (leverage > worst) {
-      worst = leverage;
-      *feature = -(l + 1);
-    }
+    if (s.pose_line_inlier[std::size_t(k)])
+      information += poseInformation(camera_, pose.T_cam_world, s.pose_lines[std::size_t(k)], pose_options);
+    if (k + 1 < num_lines && s.line_of_sample[std::size_t(k + 1)] == s.line_of_sample[std::size_t(k)]) continue;
+    consider(information, -(int(s.line_of_sample[std::size_t(k)]) + 1));
+    information.setZero();
   }
   return worst;
 }

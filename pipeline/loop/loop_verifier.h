@@ -13,6 +13,7 @@
 // the odometry covariance between the two keyframes.
 // Scratch allocated at construction; verify() allocates nothing. Deterministic.
 #include <Eigen/Geometry>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 
@@ -127,6 +128,8 @@ class LoopVerifier {
   // The candidate as the closer stores it (LoopCandidate: makeLoopCandidate of its record).
   LoopMeasurement verify(const LoopKeyframe& query, const LoopCandidate& candidate);
   const LoopVerifierOptions& options() const { return options_; }
+  // The scratch allocated at construction (behind a pointer: not in sizeof(LoopVerifier)).
+  static std::size_t scratchBytes();
 
  private:
   // The gate of a line match (options above), at the RANSAC pose.
