@@ -208,6 +208,7 @@ void LocalMapper::runLocalBa(int kf_slot, InsertResult* result) {
 
   const LocalBaSummary summary = ba_.solve(ba_options_);
   ++stats_.ba_runs;
+  stats_.ba_outlier_flags += uint64_t(summary.num_outliers);
   result->ba_initial_cost = summary.initial_cost;
   result->ba_final_cost = summary.final_cost;
   if (!summary.ok()) {
