@@ -42,7 +42,7 @@
 // it gets no step and carries no pose information. A zero or non-finite block (every observation
 // behind the camera, a point at a camera centre) holds the landmark fixed for that linearisation.
 // Nothing produces Inf or NaN. Observations with the point behind the camera (Z <= 0) are dropped
-// from the linearisation and flagged outliers.
+// from the linearisation, and flagged outliers when still behind at the end of solve().
 //
 // COVARIANCE (paper eq. 12). At the current estimate, undamped, with the same IRLS weights:
 //   C = (H_A - H_B H_C^-1 H_B^T)^-1 = S^-1,   H_A = H_pp, H_B = H_pl, H_C = H_ll,
