@@ -67,6 +67,94 @@ TEST(FastDetector, MatchesBruteForceSegmentTestAndScore) {
   }
 }
 
+// The vector scan (16 pixels a block: SSE2 on x86-64, NEON on aarch64) against the scalar
+// reference fastScore() in raster order: for every threshold 1..254, on noise, blurred noise and
+// flat patches with steps (ties at exactly the threshold), widths that are not multiples of 16,
+// regions narrower than a block (scalar path), regions ending at the image edge and inside it.
+TEST(FastDetector, VectorScanEqualsScalarReferenceForEveryThreshold) {
+  cv::RNG rng(22);
+  int images = 0, corners_checked = 0;
+  for (const int width : {16 + 6, 31, 32 + 6, 47, 53, 70}) {
+    for (int kind = 0; kind < 3; ++kind) {
+      const int height = 24;
+      cv::Mat img(height, width, CV_8UC1);
+      rng.fill(img, cv::RNG::UNIFORM, 0, 256);
+      if (kind == 1) cv::GaussianBlur(img, img, cv::Size(3, 3), 0.8);
+      if (kind == 2) {  // 4x4 patches of a few levels 10 apart: differences hit thresholds exactly
+        for (int y = 0; y < height; ++y)
+          for (int x = 0; x < width; ++x) img.at<uint8_t>(y, x) = uint8_t(100 + 10 * (((x / 4) * 7 + (y / 4) * 3) % 5));
+      }
+      ++images;
+      std::vector<int> reference(img.total(), 0);
+      for (int y = 3; y < height - 3; ++y) {
+        for (int x = 3; x < width - 3; ++x) {
+          reference[y * width + x] = fastScore(img.ptr<uint8_t>(y) + x, static_cast<int>(img.step[0]));
+          ASSERT_EQ(reference[y * width + x], bruteForceScore(img, x, y)) << "at " << x << "," << y;
+        }
+      }
+      FastDetector fast(width, height, 4096);
+      for (int threshold = 1; threshold <= 254; ++threshold) {
+        const int border = 3 + threshold % 3;
+        // Regions: the whole image, then a left part, a narrow strip and the rest of a band.
+        const int split = 3 + threshold % (width - 6), narrow = std::min(width, split + 1 + threshold % 15);
+        const int regions[4][4] = {{0, 0, width, height / 2},
+                                   {0, height / 2, split, height},
+                                   {split, height / 2, narrow, height},
+                                   {narrow, height / 2, width, height}};
+        fast.begin(img, border);
+        std::vector<FastCorner> expected;
+        for (const auto& r : regions) {
+          fast.scan(threshold, r[0], r[1], r[2], r[3]);
+          for (int y = std::max(r[1], border); y < std::min(r[3], height - border); ++y) {
+            for (int x = std::max(r[0], border); x < std::min(r[2], width - border); ++x) {
+              if (reference[y * width + x] > threshold) expected.push_back({int16_t(x), int16_t(y), uint8_t(reference[y * width + x])});
+            }
+          }
+        }
+        ASSERT_EQ(fast.numRaw(), static_cast<int>(expected.size())) << "width " << width << " kind " << kind << " threshold " << threshold;
+        for (size_t i = 0; i < expected.size(); ++i) {
+          const FastCorner& got = fast.rawCorners()[i];
+          ASSERT_TRUE(got.x == expected[i].x && got.y == expected[i].y && got.score == expected[i].score)
+              << "corner " << i << ": got " << got.x << "," << got.y << " score " << int(got.score) << ", expected "
+              << expected[i].x << "," << expected[i].y << " score " << int(expected[i].score) << " (width " << width
+              << " kind " << kind << " threshold " << threshold << ")";
+        }
+        corners_checked += static_cast<int>(expected.size());
+      }
+    }
+  }
+  EXPECT_EQ(images, 18);
+  EXPECT_GT(corners_checked, 20000);  // the images must exercise the detector at many thresholds
+}
+
+// Rows wider than the scan's buffer of blocks that passed the compass tests (64 blocks of 16):
+// a row of noise then passes it in several rounds, which must keep raster order.
+TEST(FastDetector, VectorScanOfRowsWiderThanItsBlockBuffer) {
+  const int width = 16 * 64 * 2 + 37, height = 10;
+  cv::Mat img(height, width, CV_8UC1);
+  cv::RNG rng(2222);
+  rng.fill(img, cv::RNG::UNIFORM, 0, 256);
+  FastDetector fast(width, height, 40000);
+  for (const int threshold : {1, 10, 40}) {
+    fast.begin(img, 3);
+    fast.scan(threshold, 0, 0, width, height);
+    int expected = 0;
+    for (int y = 3; y < height - 3; ++y) {
+      for (int x = 3; x < width - 3; ++x) {
+        const int score = fastScore(img.ptr<uint8_t>(y) + x, static_cast<int>(img.step[0]));
+        if (score <= threshold) continue;
+        ASSERT_LT(expected, fast.numRaw()) << "threshold " << threshold;
+        const FastCorner& got = fast.rawCorners()[expected++];
+        ASSERT_TRUE(got.x == x && got.y == y && got.score == score)
+            << "threshold " << threshold << ": got " << got.x << "," << got.y << " score " << int(got.score)
+            << ", expected " << x << "," << y << " score " << score;
+      }
+    }
+    EXPECT_EQ(fast.numRaw(), expected) << "threshold " << threshold;
+    EXPECT_GT(expected, 1000) << "threshold " << threshold;  // most blocks pass the compass tests
+  }
+}
+
 TEST(OrbExtraction, RealFrameGivesAboutOneThousandUndistortedKeypoints) {
   RgbdImage frame;
   if (!test::loadTumRpyFrame(10, &frame)) GTEST_SKIP() << "TUM fr1/rpy not found under " << test::tumRpyDir();
