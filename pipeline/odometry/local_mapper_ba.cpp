@@ -265,9 +265,10 @@ void LocalMapper::runLocalBa(int kf_slot, InsertResult* result) {
     line.end_world += shift;
   }
 
-  // Outlier observations leave the map. A line observation goes when most of its samples fail.
+  // Outlier observations leave the map (when enabled). A line observation goes when most of its
+  // samples fail.
   int outliers = 0;
-  int o = 0;
+  int o = options_.mapper.remove_ba_outliers ? 0 : num_obs;
   while (o < num_obs) {
     const BaObservation& obs = ba_observations_[std::size_t(o)];
     if (!obs.is_line) {

@@ -346,9 +346,16 @@ const LocalMapPoint* landmarkOf(const LocalMap& map, const test::ScenePoint& s) 
 // different scene point, metres away). Local BA flags them after solve() and the mapper removes
 // exactly those observations, after the covariance (which must not reset the flags), while the
 // landmarks keep their two correct observations.
-TEST(LocalMapper, LocalBaOutlierObservationsLeaveTheMap) {
+// Five keypoints of a third keyframe associated with the wrong landmarks: the BA flags them; with
+// `remove_ba_outliers` they leave the map, by default they are only counted.
+class LocalMapperBaOutliers : public ::testing::TestWithParam<bool> {};
+
+TEST_P(LocalMapperBaOutliers, AreFlaggedAndLeaveTheMapOnlyWhenEnabled) {
+  const bool remove = GetParam();
   const test::Scene scene = test::makeScene(19, 200, 0, kStart, 1.0, 4.0);
-  Fixture fx;
+  OdometryOptions options;
+  options.mapper.remove_ba_outliers = remove;
+  Fixture fx(options);
   fx.mapper->insertKeyframe(*test::newMapRequest(test::observe(scene, kStart), kStart, 0));
   const Eigen::Isometry3d step = pose(0.5, Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0.01, 0, 0.005));
   const Eigen::Isometry3d T1 = kStart * step;
@@ -380,9 +387,20 @@ TEST(LocalMapper, LocalBaOutlierObservationsLeaveTheMap) {
   const InsertResult r = fx.mapper->insertKeyframe(*request);
   ASSERT_TRUE(r.inserted);
   EXPECT_EQ(r.new_points, 0);
+  EXPECT_GE(fx.mapper->stats().ba_outlier_flags, uint64_t(kWrong));
+  if (!remove) {
+    // Counted, not acted on: points 0..4 keep their wrong third observation.
+    EXPECT_EQ(r.ba_outliers, 0);
+    EXPECT_EQ(fx.mapper->stats().ba_outlier_observations, 0u);
+    for (std::size_t s = 0; s < 2 * kWrong; ++s) {
+      const LocalMapPoint* p = landmarkOf(fx.mapper->localMap(), scene.points[s]);
+      ASSERT_NE(p, nullptr) << s;
+      EXPECT_EQ(p->keyframe_observations, s < kWrong ? 3 : 2) << "scene point " << s;
+    }
+    return;
+  }
   EXPECT_EQ(r.ba_outliers, kWrong);
   EXPECT_EQ(fx.mapper->stats().ba_outlier_observations, uint64_t(kWrong));
-  EXPECT_GE(fx.mapper->stats().ba_outlier_flags, uint64_t(kWrong));
   // Points 0..9: their two correct observations (points 5..9 lost none: the keypoints were
   // associated elsewhere); every other point has all three. The culled observations still pulled
   // this BA's estimate of their landmarks (the kernel bounds it: ~1 cm here; the mapper solves
@@ -408,6 +426,9 @@ TEST(LocalMapper, LocalBaOutlierObservationsLeaveTheMap) {
     EXPECT_LT((p->P_world - scene.points[s].P_world).norm(), 1e-3) << "after the next keyframe, scene point " << s;
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(LocalMapper, LocalMapperBaOutliers, ::testing::Bool(),
+                         [](const ::testing::TestParamInfo<bool>& info) { return info.param ? "Removed" : "CountedByDefault"; });
 
 TEST(LocalMapper, KeyframeCapacityRetiresTheOldestWithCovariances) {
   const test::Scene scene = test::makeScene(17, 150, 0, kStart, 2.0, 5.0);
