@@ -42,7 +42,7 @@
 // it gets no step and carries no pose information. A zero or non-finite block (every observation
 // behind the camera, a point at a camera centre) holds the landmark fixed for that linearisation.
 // Nothing produces Inf or NaN. Observations with the point behind the camera (Z <= 0) are dropped
-// from the linearisation and flagged outliers.
+// from the linearisation, and flagged outliers when still behind at the end of solve().
 //
 // COVARIANCE (paper eq. 12). At the current estimate, undamped, with the same IRLS weights:
 //   C = (H_A - H_B H_C^-1 H_B^T)^-1 = S^-1,   H_A = H_pp, H_B = H_pl, H_C = H_ll,
@@ -195,13 +195,15 @@ class LocalBundleAdjuster {
   const Eigen::Isometry3d& pose(int keyframe) const { return keyframes_[keyframe].T_cam_world; }
   const Eigen::Vector3d& landmark(int landmark) const { return landmarks_[landmark].P_world; }
   double observationChi2(int observation) const { return observations_[observation].chi2; }
+  // solve()'s chi-square classification at its final estimate (updateOutlierFlags; also behind the
+  // camera). computeCovariance() and computeStep() leave it as it is.
   bool isOutlier(int observation) const { return observations_[observation].outlier; }
   double cost(const LocalBaOptions& options) const;  // robust cost at the current estimate
   // A posteriori variance factor sigma0^2 (solver/variance_factor.h) of the inliers after solve():
   // redundancy = inlier error dof - 6 per optimised pose - per landmark min(its inlier error dof,
   // 3 for a point, 2 for a line sample: its slide along the line is unobservable).
-  // Read it before computeCovariance(), which may re-linearise (and so re-evaluate the chi2 values
-  // and reset the outlier flags; docs/SOLVER.md). local_ba_variance.cpp.
+  // Read it before computeCovariance(), which may re-linearise (and so re-evaluate the chi2
+  // values; the outlier flags stay solve()'s). local_ba_variance.cpp.
   double varianceFactor(const LocalBaOptions& options) const;
   // Variance components of the POINT residuals after solve() (before computeCovariance(), like
   // varianceFactor): the stereo residual [u, v, u_r] is split into its pixel part [u, v] and its

@@ -115,11 +115,12 @@ double LocalBundleAdjuster::linearize(const LocalBaOptions& options) {
     for (int n = 0; n < lm.num_observations; ++n) {
       Observation& obs = observations_[observation_order_[lm.first_observation + n]];
       obs.valid = false;
+      // The outlier flags are solve()'s result (updateOutlierFlags), not touched here: the
+      // linearisation of computeCovariance() must leave them for the map stage's culling.
       if (!obs.enabled) continue;
-      obs.outlier = true;  // until it is linearised
       Keyframe& kf = keyframes_[obs.keyframe];
       const Eigen::Vector3d P_cam = kf.T_cam_world * lm.P_world;
-      if (!(P_cam.z() > kFactorMinDepth)) continue;  // behind the camera: an outlier this time
+      if (!(P_cam.z() > kFactorMinDepth)) continue;  // behind the camera: not linearised this time
       const RobustKernel kernel = options.kernelFor(obs.kind);
       Eigen::Matrix3d M;
       Eigen::Vector3d q;
@@ -163,7 +164,6 @@ double LocalBundleAdjuster::linearize(const LocalBaOptions& options) {
           k = evaluateKernel(kernel, obs.chi2);
           cost += 0.5 * k.rho;
           obs.valid = true;
-          obs.outlier = false;
           const double c = k.rho1 * obs.information(0, 0) * information_scales_.line;
           const Eigen::Vector3d j = J_cam.transpose();
           const Eigen::Vector3d r = kf.T_cam_world.linear().transpose() * j;
@@ -183,7 +183,6 @@ double LocalBundleAdjuster::linearize(const LocalBaOptions& options) {
       }
       cost += 0.5 * k.rho;
       obs.valid = true;
-      obs.outlier = false;
       const Eigen::Matrix3d R = kf.T_cam_world.linear();
       const Eigen::Matrix3d MR = M * R;
       lm.H_point.noalias() += R.transpose() * MR;

@@ -121,17 +121,11 @@ bool LocalBundleAdjuster::computeCovariance(const LocalBaOptions& options, const
   covariance_valid_ = false;
   buildStructure();
   const bool unit_scales = scales.pixel == 1.0 && scales.depth == 1.0 && scales.line == 1.0;
-  if (linearized_at_estimate_ && unit_scales) {
-    // solve() ended at its last linearisation point (its last step was rejected, or it ran no
-    // step) and the covariance weighs the residuals as solve() did: the stored blocks are this
-    // linearisation. Its flags as linearize() leaves them: an enabled observation is an outlier
-    // exactly when it was not linearised.
-    for (int k = 0; k < num_observations_; ++k) {
-      Observation& obs = observations_[k];
-      if (obs.enabled) obs.outlier = !obs.valid;
-    }
-  } else {
-    // Variance components weigh the residual kinds differently from solve(): linearise again.
+  // When solve() ended at its last linearisation point (its last step was rejected, or it ran no
+  // step) and the covariance weighs the residuals as solve() did, the stored blocks are this
+  // linearisation. Otherwise (the estimate moved, or variance components weigh the residual kinds
+  // differently): linearise again. Either way solve()'s outlier flags stay as they are.
+  if (!(linearized_at_estimate_ && unit_scales)) {
     information_scales_ = scales;
     linearize(options);
     information_scales_ = InformationScales();

@@ -44,6 +44,10 @@ struct MapperStats {
   uint64_t points_culled = 0;
   uint64_t lines_culled = 0;
   uint64_t ba_runs = 0;
+  // Observations solve() flagged above their chi-square threshold (summed over BA runs), and the
+  // map observations the mapper removed for them (a line observation counts once, removed when
+  // most of its samples were flagged).
+  uint64_t ba_outlier_flags = 0;
   uint64_t ba_outlier_observations = 0;
   // BA covariances not published: windows whose reduced system was (numerically) singular, and
   // keyframe covariances not finite, not positive definite or beyond

@@ -208,6 +208,7 @@ void LocalMapper::runLocalBa(int kf_slot, InsertResult* result) {
 
   const LocalBaSummary summary = ba_.solve(ba_options_);
   ++stats_.ba_runs;
+  stats_.ba_outlier_flags += uint64_t(summary.num_outliers);
   result->ba_initial_cost = summary.initial_cost;
   result->ba_final_cost = summary.final_cost;
   if (!summary.ok()) {
@@ -264,9 +265,10 @@ void LocalMapper::runLocalBa(int kf_slot, InsertResult* result) {
     line.end_world += shift;
   }
 
-  // Outlier observations leave the map. A line observation goes when most of its samples fail.
+  // Outlier observations leave the map (when enabled). A line observation goes when most of its
+  // samples fail.
   int outliers = 0;
-  int o = 0;
+  int o = options_.mapper.remove_ba_outliers ? 0 : num_obs;
   while (o < num_obs) {
     const BaObservation& obs = ba_observations_[std::size_t(o)];
     if (!obs.is_line) {

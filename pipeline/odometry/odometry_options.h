@@ -65,6 +65,12 @@ struct LocalMapperOptions {
   int min_observers = 2;
   int cull_after_keyframes = 3;
   float max_line_sample_outlier_ratio = 0.5f;  // lines whose BA samples fail this often go
+  // Whether the observations local BA's solve() flags as outliers leave the map (and count toward
+  // a line's sample outlier ratio above). Off: a binary-pair study (docs/ODOMETRY.md "Local BA
+  // outlier culling") found no gain on average (head250 six-start mean --out -0.7 %,
+  // --out-optimized +1.1 %) and a loss on the noise-free office scenes (+3-4 %), the proxy for
+  // rendered datasets; the flags are still computed and counted (map.ba_outlier_flags).
+  bool remove_ba_outliers = false;
   int covisible_keyframes_in_local_map = 10;   // keyframes whose landmarks make the snapshot
 };
 

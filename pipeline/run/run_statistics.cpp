@@ -67,9 +67,10 @@ std::string runSummaryJson(const RunSummary& r) {
   add(std::snprintf(buf, sizeof(buf),
                     "  \"map\": {\"points_created\": %" PRIu64 ", \"lines_created\": %" PRIu64
                     ", \"points_culled\": %" PRIu64 ", \"lines_culled\": %" PRIu64 ", \"ba_runs\": %" PRIu64
-                    ", \"ba_outlier_observations\": %" PRIu64 ", \"ba_covariances_refused\": %" PRIu64 ",\n",
+                    ", \"ba_outlier_flags\": %" PRIu64 ", \"ba_outlier_observations\": %" PRIu64
+                    ", \"ba_covariances_refused\": %" PRIu64 ",\n",
                     m.points_created, m.lines_created, m.points_culled, m.lines_culled, m.ba_runs,
-                    m.ba_outlier_observations, m.ba_covariances_refused));
+                    m.ba_outlier_flags, m.ba_outlier_observations, m.ba_covariances_refused));
   add(std::snprintf(buf, sizeof(buf),
                     "          \"peak\": {\"keyframes\": %zu, \"points\": %zu, \"lines\": %zu, "
                     "\"point_observations\": %zu, \"line_observations\": %zu},\n",

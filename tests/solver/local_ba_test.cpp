@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "platform/allocation_counter.h"
 #include "solver/noise_model.h"
@@ -84,6 +85,49 @@ TEST(LocalBa, FlagsOutliersForCulling) {
   }
   ASSERT_TRUE(ba.solve(options).ok());
   expectRecovered(w, ba, 3e-3, 1e-2);
+}
+
+// The flags are solve()'s chi-square classification, which the map stage reads AFTER the
+// covariance (pipeline/odometry/local_mapper_ba.cpp): computeCovariance() must leave them as they
+// are on each of its paths (eliminating from the stored linearisation, linearising again at the
+// moved estimate, and with variance components). It once reset them to "not linearised", so the
+// mapper culled almost nothing.
+TEST(LocalBa, CovarianceKeepsTheOutlierFlagsOfSolve) {
+  SyntheticWindowConfig config;
+  config.seed = 5;
+  config.outlier_fraction = 0.05;
+  const SyntheticWindow w = makeSyntheticWindow(config);
+  struct Path {
+    const char* name;
+    int max_iterations;  // 0: solve() ends at its linearisation point (the stored blocks are reused)
+    InformationScales scales;
+  };
+  InformationScales components;
+  components.pixel = 0.7;
+  components.depth = 1.4;
+  for (const Path& path : {Path{"reused", 0, InformationScales()}, Path{"relinearised", 20, InformationScales()},
+                           Path{"variance components", 20, components}}) {
+    LocalBundleAdjuster ba;
+    loadWindow(w, /*initial=*/true, &ba);
+    LocalBaOptions options;
+    options.max_iterations = path.max_iterations;
+    const LocalBaSummary summary = ba.solve(options);
+    ASSERT_TRUE(summary.ok()) << path.name;
+    std::vector<bool> flags(static_cast<std::size_t>(ba.numObservations()));
+    int true_outliers_flagged = 0;
+    for (int k = 0; k < ba.numObservations(); ++k) {
+      flags[static_cast<std::size_t>(k)] = ba.isOutlier(k);
+      true_outliers_flagged += w.observations[k].is_outlier && ba.isOutlier(k) ? 1 : 0;
+    }
+    ASSERT_GT(true_outliers_flagged, 20) << path.name;  // gross outliers exist and were flagged
+    ASSERT_TRUE(ba.computeCovariance(options, path.scales)) << path.name;
+    int flagged_after = 0;
+    for (int k = 0; k < ba.numObservations(); ++k) {
+      ASSERT_EQ(ba.isOutlier(k), flags[static_cast<std::size_t>(k)]) << path.name << ", observation " << k;
+      flagged_after += ba.isOutlier(k) ? 1 : 0;
+    }
+    EXPECT_EQ(flagged_after, summary.num_outliers) << path.name;
+  }
 }
 
 // computeCovariance() eliminates from the stored linearisation when solve() ended at its point

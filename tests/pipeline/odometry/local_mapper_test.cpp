@@ -334,6 +334,102 @@ TEST(LocalMapper, CullsUnconfirmedAndRarelyFoundLandmarks) {
   EXPECT_EQ(fx.mapper->stats().points_culled, 70u);
 }
 
+// The snapshot's landmark of a scene point (by descriptor), or nullptr.
+const LocalMapPoint* landmarkOf(const LocalMap& map, const test::ScenePoint& s) {
+  for (const LocalMapPoint& p : map.points) {
+    if (sameDescriptor(p.descriptor, s.descriptor)) return &p;
+  }
+  return nullptr;
+}
+
+// A third keyframe associates five keypoints with the wrong landmarks (gross outliers: each is a
+// different scene point, metres away). Local BA flags them after solve() and the mapper removes
+// exactly those observations, after the covariance (which must not reset the flags), while the
+// landmarks keep their two correct observations.
+// Five keypoints of a third keyframe associated with the wrong landmarks: the BA flags them; with
+// `remove_ba_outliers` they leave the map, by default they are only counted.
+class LocalMapperBaOutliers : public ::testing::TestWithParam<bool> {};
+
+TEST_P(LocalMapperBaOutliers, AreFlaggedAndLeaveTheMapOnlyWhenEnabled) {
+  const bool remove = GetParam();
+  const test::Scene scene = test::makeScene(19, 200, 0, kStart, 1.0, 4.0);
+  OdometryOptions options;
+  options.mapper.remove_ba_outliers = remove;
+  Fixture fx(options);
+  fx.mapper->insertKeyframe(*test::newMapRequest(test::observe(scene, kStart), kStart, 0));
+  const Eigen::Isometry3d step = pose(0.5, Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0.01, 0, 0.005));
+  const Eigen::Isometry3d T1 = kStart * step;
+  ASSERT_TRUE(fx.mapper->insertKeyframe(*trackedRequest(test::observe(scene, T1), T1, 1, fx.mapper->localMap())).inserted);
+  constexpr int kWrong = 5;
+  for (int s = 0; s < 2 * kWrong; ++s) {
+    const LocalMapPoint* p = landmarkOf(fx.mapper->localMap(), scene.points[std::size_t(s)]);
+    ASSERT_NE(p, nullptr) << s;
+    ASSERT_EQ(p->keyframe_observations, 2) << s;
+  }
+
+  // The third keyframe sees scene points 5..199; its keypoints of points 5..9 are associated with
+  // the landmarks of points 0..4 instead.
+  test::Scene seen;
+  seen.points.assign(scene.points.begin() + kWrong, scene.points.end());
+  const Eigen::Isometry3d T2 = T1 * step;
+  const test::View v = test::observe(seen, T2);
+  auto request = trackedRequest(v, T2, 2, fx.mapper->localMap());
+  int wrong = 0;
+  for (std::size_t k = 0; k < v.features->keypoints.size(); ++k) {
+    const int s = v.keypoint_point[k] + kWrong;  // scene index
+    if (s >= 2 * kWrong) continue;
+    const test::ScenePoint& other = scene.points[std::size_t(s - kWrong)];
+    ASSERT_GT((other.P_world - scene.points[std::size_t(s)].P_world).norm(), 0.2);
+    request->keypoint_landmark[k] = landmarkOf(fx.mapper->localMap(), other)->ref;
+    ++wrong;
+  }
+  ASSERT_EQ(wrong, kWrong);
+  const InsertResult r = fx.mapper->insertKeyframe(*request);
+  ASSERT_TRUE(r.inserted);
+  EXPECT_EQ(r.new_points, 0);
+  EXPECT_GE(fx.mapper->stats().ba_outlier_flags, uint64_t(kWrong));
+  if (!remove) {
+    // Counted, not acted on: points 0..4 keep their wrong third observation.
+    EXPECT_EQ(r.ba_outliers, 0);
+    EXPECT_EQ(fx.mapper->stats().ba_outlier_observations, 0u);
+    for (std::size_t s = 0; s < 2 * kWrong; ++s) {
+      const LocalMapPoint* p = landmarkOf(fx.mapper->localMap(), scene.points[s]);
+      ASSERT_NE(p, nullptr) << s;
+      EXPECT_EQ(p->keyframe_observations, s < kWrong ? 3 : 2) << "scene point " << s;
+    }
+    return;
+  }
+  EXPECT_EQ(r.ba_outliers, kWrong);
+  EXPECT_EQ(fx.mapper->stats().ba_outlier_observations, uint64_t(kWrong));
+  // Points 0..9: their two correct observations (points 5..9 lost none: the keypoints were
+  // associated elsewhere); every other point has all three. The culled observations still pulled
+  // this BA's estimate of their landmarks (the kernel bounds it: ~1 cm here; the mapper solves
+  // once, culling afterwards), not that of the others.
+  const LocalMap& map = fx.mapper->localMap();
+  for (std::size_t s = 0; s < scene.points.size(); ++s) {
+    const LocalMapPoint* p = landmarkOf(map, scene.points[s]);
+    ASSERT_NE(p, nullptr) << s;
+    EXPECT_EQ(p->keyframe_observations, s < 2 * kWrong ? 2 : 3) << "scene point " << s;
+    EXPECT_LT((p->P_world - scene.points[s].P_world).norm(), s < kWrong ? 3e-2 : 1e-3) << "scene point " << s;
+  }
+  EXPECT_LT(translationError(map.T_world_reference, T2), 1e-3);
+
+  // The next keyframe's BA no longer sees them: every landmark is back at the truth (with the
+  // wrong observations kept, the pull would stay).
+  const Eigen::Isometry3d T3 = T2 * step;
+  const InsertResult r3 = fx.mapper->insertKeyframe(*trackedRequest(test::observe(scene, T3), T3, 3, fx.mapper->localMap()));
+  ASSERT_TRUE(r3.inserted);
+  EXPECT_EQ(r3.ba_outliers, 0);
+  for (std::size_t s = 0; s < scene.points.size(); ++s) {
+    const LocalMapPoint* p = landmarkOf(fx.mapper->localMap(), scene.points[s]);
+    ASSERT_NE(p, nullptr) << s;
+    EXPECT_LT((p->P_world - scene.points[s].P_world).norm(), 1e-3) << "after the next keyframe, scene point " << s;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(LocalMapper, LocalMapperBaOutliers, ::testing::Bool(),
+                         [](const ::testing::TestParamInfo<bool>& info) { return info.param ? "Removed" : "CountedByDefault"; });
+
 TEST(LocalMapper, KeyframeCapacityRetiresTheOldestWithCovariances) {
   const test::Scene scene = test::makeScene(17, 150, 0, kStart, 2.0, 5.0);
   Fixture fx;
