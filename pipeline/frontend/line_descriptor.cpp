@@ -12,6 +12,25 @@ namespace {
 constexpr int kBands = 9;
 constexpr int kStats = 8;  // 4 LBD sums x 2 halves of the segment
 
+// LBD's global Gaussian across the region (sigma = half the rows) at row r of `rows`.
+float rowWeight(int r, int rows) {
+  const float offset = static_cast<float>(r - rows / 2);
+  const float sigma = 0.5f * rows;
+  return std::exp(-0.5f * offset * offset / (sigma * sigma));
+}
+
+// The weights depend on the row count alone: those of the default band width (3) once, not an
+// exp per row of every descriptor (the same calls, so the same values).
+constexpr int kDefaultRows = kBands * 3;
+const std::array<float, kDefaultRows>& defaultRowWeights() {
+  static const std::array<float, kDefaultRows> weights = [] {
+    std::array<float, kDefaultRows> w{};
+    for (int r = 0; r < kDefaultRows; ++r) w[r] = rowWeight(r, kDefaultRows);
+    return w;
+  }();
+  return weights;
+}
+
 }  // namespace
 
 void computeLineDescriptor(const cv::Mat& image, const cv::Point2f& start, const cv::Point2f& end,
@@ -27,7 +46,8 @@ void computeLineDescriptor(const cv::Mat& image, const cv::Point2f& start, const
   const int rows = kBands * w;
   const int half_rows = rows / 2;
   const int positions = std::clamp(static_cast<int>(length), 4, std::max(4, options.max_positions));
-  const float sigma = 0.5f * rows;  // LBD's global Gaussian across the region
+  const std::array<float, kDefaultRows>& default_weights = defaultRowWeights();
+  const float step_x = dx / positions, step_y = dy / positions;
   const int x_max = image.cols - 2, y_max = image.rows - 2;
   const int stride = static_cast<int>(image.step[0]);
   const uint8_t* data = image.ptr<uint8_t>(0);
@@ -35,12 +55,11 @@ void computeLineDescriptor(const cv::Mat& image, const cv::Point2f& start, const
 
   for (int r = 0; r < rows; ++r) {
     const float offset = static_cast<float>(r - half_rows);
-    const float weight = std::exp(-0.5f * offset * offset / (sigma * sigma));
+    const float weight = rows == kDefaultRows ? default_weights[r] : rowWeight(r, rows);
     const cv::v_float32x4 v_weight = cv::v_setall_f32(weight);
     std::array<float, kStats>& stats = band[r / w];
     // Walk the row incrementally; +0.5 then truncation rounds (coordinates are >= 0 inside).
     // The first and second half of the positions feed separate sums.
-    const float step_x = dx / positions, step_y = dy / positions;
     float fx = start.x + 0.5f * step_x + offset * nx + 0.5f, fy = start.y + 0.5f * step_y + offset * ny + 0.5f;
     const int half_end[2] = {(positions + 1) / 2, positions};  // 2k >= positions: second half
     // Whether every sample of the row is inside (x, y in [1, max]): the positions are monotone in
@@ -79,24 +98,27 @@ void computeLineDescriptor(const cv::Mat& image, const cv::Point2f& start, const
     }
   }
 
+  // The comparisons 4 at a time, as sign masks: 208 bits of 8 (one pair of bands: s = 0..7, so
+  // no group crosses a 64-bit word), then 8 groups of 6 within bands, all in the last word.
   int bit = 0;
-  auto put = [&](bool value) {
-    if (value) out.words[bit >> 6] |= 1ULL << (bit & 63);
-    ++bit;
-  };
   for (int i = 0; i < kBands; ++i) {
+    const cv::v_float32x4 lo_i = cv::v_load(band[i].data()), hi_i = cv::v_load(band[i].data() + 4);
     for (int j = i + 1; j < kBands && j - i <= 4; ++j) {
-      for (int s = 0; s < kStats; ++s) put(band[i][s] > band[j][s]);
+      const cv::v_float32x4 lo_j = cv::v_load(band[j].data()), hi_j = cv::v_load(band[j].data() + 4);
+      const uint64_t bits = static_cast<uint64_t>(cv::v_signmask(lo_i > lo_j) | cv::v_signmask(hi_i > hi_j) << 4);
+      out.words[bit >> 6] |= bits << (bit & 63);
+      bit += 8;
     }
   }
   for (int i = 0; i < kBands - 1; ++i) {  // 8 bands x 6 = 48 bits
-    const std::array<float, kStats>& b = band[i];
-    put(b[0] > b[1]);
-    put(b[4] > b[5]);
-    put(b[2] > b[3]);
-    put(b[6] > b[7]);
-    put(b[0] > b[4]);
-    put(b[1] > b[5]);
+    // (b0 > b1, b4 > b5, b2 > b3, b6 > b7), then (b0 > b4, b1 > b5).
+    const cv::v_float32x4 lo = cv::v_load(band[i].data()), hi = cv::v_load(band[i].data() + 4);
+    cv::v_float32x4 z0, z1;
+    cv::v_zip(lo, hi, z0, z1);  // (b0, b4, b1, b5), (b2, b6, b3, b7)
+    const int pairs = cv::v_signmask(cv::v_combine_low(z0, z1) > cv::v_combine_high(z0, z1));
+    const int halves = cv::v_signmask(lo > hi) & 3;
+    out.words[bit >> 6] |= static_cast<uint64_t>(pairs | halves << 4) << (bit & 63);
+    bit += 6;
   }
 }
 

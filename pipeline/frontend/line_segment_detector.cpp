@@ -6,18 +6,27 @@
 
 #include <opencv2/core/hal/intrin.hpp>
 
+#include "pipeline/frontend/lsd_kernels.h"
+
 namespace plumb {
 namespace {
 
 constexpr int kBins = 1024;
-// Free = 1 so that a row of three states is directly a bit mask of the free pixels.
-constexpr uint8_t kFree = 1, kUsed = 0;
+constexpr uint8_t kFree = kLsdFree, kUsed = kLsdUsed;
 // The region growing reads the states of the 3x3 neighbourhood as three little-endian words
 // (p - w - 1 .. p - w + 2, p - 1 .. p + 2, p + w - 1 .. p + w + 2), so the state array has a used
 // row and one byte before pixel 0 (stateFront) and three bytes after the last pixel.
 constexpr int kStateBack = 3;
 int stateFront(int width) { return width + 1; }
-static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "freeBits reads states as a little-endian word");
+static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "neighbour masks read states as little-endian words");
+
+// Neighbours by bit of lsdNeighbourMask (bits 3, 7, 11 never set): raster order, a row a nibble.
+constexpr int8_t kNeighbourDx[12] = {-1, 0, 1, 0, -1, 0, 1, 0, -1, 0, 1, 0};
+constexpr int8_t kNeighbourDy[12] = {-1, -1, -1, 0, 0, 0, 0, 0, 1, 1, 1, 0};
+
+// A step (dx, dy) as the 32-bit word that, added to a region pixel's (x, y) word (x the low
+// int16 half), adds both coordinates at once: exact while x + dx stays >= 0 (no borrow).
+uint32_t packedStep(int dx, int dy) { return static_cast<uint32_t>(dx + dy * 65536); }
 
 // The states of 4 pixels from the 4-bit mask of which are above the threshold (bit i: pixel i).
 struct StateBytes {
@@ -33,16 +42,6 @@ constexpr StateBytes kStateBytes[16] = {stateBytes(0),  stateBytes(1),  stateByt
                                         stateBytes(8),  stateBytes(9),  stateBytes(10), stateBytes(11),
                                         stateBytes(12), stateBytes(13), stateBytes(14), stateBytes(15)};
 
-// Four bytes widened to int32 lanes. OpenCV 4.6's SSE v_load_expand_q reads them through an
-// int*, which is undefined behaviour (UBSan: misaligned load) when the address is not a multiple
-// of 4; the x + 1 loads below never are. Copying into an aligned buffer first is defined;
-// compilers fold the copy into the same single 32-bit load.
-inline cv::v_int32x4 loadExpand4(const uint8_t* p) {
-  alignas(4) uint8_t bytes[4];
-  std::memcpy(bytes, p, sizeof(bytes));
-  return cv::v_reinterpret_as_s32(cv::v_load_expand_q(bytes));
-}
-
 }  // namespace
 
 LineSegmentDetector::LineSegmentDetector(int max_width, int max_height, const LineSegmentDetectorOptions& options)
@@ -56,8 +55,7 @@ LineSegmentDetector::LineSegmentDetector(int max_width, int max_height, const Li
   bucket_start_.resize(kBins + 1);
   ordered_.resize(n);
   region_.resize(n);
-  region_x_.resize(n);
-  region_y_.resize(n);
+  region_xy_.resize(n);
   candidate_.resize(n);
   candidate_bin_.resize(n);
 }
@@ -71,11 +69,15 @@ int LineSegmentDetector::detect(const cv::Mat& image, float min_length, Detected
   const float threshold = options_.quantization / std::sin(tau);
   const float cos_tau = std::cos(tau);
 
-  // 2x2 gradient at (x + 0.5, y + 0.5); the last row and column have none. Four pixels per
-  // step in float lanes: the same IEEE operations in the same order as the scalar tail (sqrt and
-  // division are correctly rounded either way), so both give identical values.
-  const cv::v_float32x4 v_half = cv::v_setall_f32(0.5f), v_one = cv::v_setall_f32(1.f);
-  const cv::v_float32x4 v_zero = cv::v_setzero_f32(), v_threshold = cv::v_setall_f32(threshold);
+  // 2x2 gradient at (x + 0.5, y + 0.5); the last row and column have none. Eight pixels per
+  // step: the doubled gradient 2 gx = b + d - a - c (|.| <= 510) in int16 lanes, its squared
+  // norm 4 (gx^2 + gy^2) <= 520,200 from one multiply-add of (2 gx, 2 gy) pairs in int32, then
+  // float lanes. Every value is exactly the scalar tail's: 0.5 * (2 gx) and the sum of squares
+  // are exact in float either way (quarter units below 2^24), and sqrt and division are
+  // correctly rounded.
+  const cv::v_float32x4 v_half = cv::v_setall_f32(0.5f), v_quarter = cv::v_setall_f32(0.25f);
+  const cv::v_float32x4 v_one = cv::v_setall_f32(1.f), v_zero = cv::v_setzero_f32();
+  const cv::v_float32x4 v_threshold = cv::v_setall_f32(threshold);
   cv::v_float32x4 v_max = cv::v_setzero_f32();
   float max_magnitude = 0;
   for (int y = 0; y < h; ++y) {
@@ -90,22 +92,32 @@ int LineSegmentDetector::detect(const cv::Mat& image, float min_length, Detected
     }
     const uint8_t* r0 = image.ptr<uint8_t>(y);
     const uint8_t* r1 = image.ptr<uint8_t>(y + 1);
-    int x = 0;
-    for (; x + 4 < w; x += 4) {  // reads x .. x + 4: stays inside the row
-      const cv::v_int32x4 a = loadExpand4(r0 + x);
-      const cv::v_int32x4 b = loadExpand4(r0 + x + 1);
-      const cv::v_int32x4 c = loadExpand4(r1 + x);
-      const cv::v_int32x4 d = loadExpand4(r1 + x + 1);
-      const cv::v_float32x4 gx = v_half * cv::v_cvt_f32(b + d - a - c);
-      const cv::v_float32x4 gy = v_half * cv::v_cvt_f32(c + d - a - b);
-      const cv::v_float32x4 m = cv::v_sqrt(gx * gx + gy * gy);
-      const cv::v_float32x4 positive = m > v_zero;
-      const cv::v_float32x4 inv = cv::v_select(positive, v_one / m, v_zero);
+    // Four pixels' magnitude, unit direction, states and running maximum from their doubled
+    // gradients (int32 lanes) and squared norms.
+    auto finish = [&](int x, const cv::v_int32x4& gx2, const cv::v_int32x4& gy2, const cv::v_int32x4& norm2) {
+      const cv::v_float32x4 gx = v_half * cv::v_cvt_f32(gx2), gy = v_half * cv::v_cvt_f32(gy2);
+      const cv::v_float32x4 m = cv::v_sqrt(cv::v_cvt_f32(norm2) * v_quarter);
+      const cv::v_float32x4 inv = cv::v_select(m > v_zero, v_one / m, v_zero);
       cv::v_store(mag + x, m);
       cv::v_store(ux + x, gx * inv);
       cv::v_store(uy + x, gy * inv);
       std::memcpy(st + x, &kStateBytes[cv::v_signmask(m > v_threshold)], 4);
       v_max = cv::v_max(v_max, m);
+    };
+    int x = 0;
+    for (; x + 8 < w; x += 8) {  // reads x .. x + 8: stays inside the row
+      const cv::v_int16x8 a = cv::v_reinterpret_as_s16(cv::v_load_expand(r0 + x));
+      const cv::v_int16x8 b = cv::v_reinterpret_as_s16(cv::v_load_expand(r0 + x + 1));
+      const cv::v_int16x8 c = cv::v_reinterpret_as_s16(cv::v_load_expand(r1 + x));
+      const cv::v_int16x8 d = cv::v_reinterpret_as_s16(cv::v_load_expand(r1 + x + 1));
+      const cv::v_int16x8 gx2 = b + d - a - c, gy2 = c + d - a - b;  // no saturation: |.| <= 510
+      cv::v_int16x8 pairs_lo, pairs_hi;
+      cv::v_zip(gx2, gy2, pairs_lo, pairs_hi);
+      cv::v_int32x4 gx2_lo, gx2_hi, gy2_lo, gy2_hi;
+      cv::v_expand(gx2, gx2_lo, gx2_hi);
+      cv::v_expand(gy2, gy2_lo, gy2_hi);
+      finish(x, gx2_lo, gy2_lo, cv::v_dotprod(pairs_lo, pairs_lo));
+      finish(x + 4, gx2_hi, gy2_hi, cv::v_dotprod(pairs_hi, pairs_hi));
     }
     for (; x < w - 1; ++x) {
       const int a = r0[x], b = r0[x + 1], c = r1[x], d = r1[x + 1];
@@ -141,23 +153,39 @@ int LineSegmentDetector::detect(const cv::Mat& image, float min_length, Detected
   int* candidate = candidate_.data();
   uint16_t* candidate_bin = candidate_bin_.data();
   int candidates = 0;
-  for (int i = 0; i < n; ++i) {
-    if (state[i] != kFree) continue;
+  auto collect = [&](int i) {
     const int bin = kBins - 1 - static_cast<int>(magnitude[i] * bin_scale);
     candidate[candidates] = i;
     candidate_bin[candidates++] = static_cast<uint16_t>(bin);
     ++bucket_start[bin + 1];
+  };
+  // 16 states a step as a bit mask of the free ones (a third of a Kinect frame's pixels are
+  // candidates: fewer tests and no branch per pixel), in raster order.
+  const cv::v_uint8x16 v_free = cv::v_setall_u8(kFree);
+  int i = 0;
+  for (; i + 16 <= n; i += 16) {
+    uint32_t mask = static_cast<uint32_t>(cv::v_signmask(cv::v_load(state + i) == v_free));
+    while (mask != 0) {
+      collect(i + __builtin_ctz(mask));
+      mask &= mask - 1;
+    }
+  }
+  for (; i < n; ++i) {
+    if (state[i] == kFree) collect(i);
   }
   for (int b = 0; b < kBins; ++b) bucket_start[b + 1] += bucket_start[b];
   int* ordered = ordered_.data();
   for (int k = 0; k < candidates; ++k) ordered[bucket_start[candidate_bin[k]]++] = candidate[k];
 
-  const int neighbour_offset[9] = {-w - 1, -w, -w + 1, -1, 0, 1, w - 1, w, w + 1};
-  static constexpr int8_t kNeighbourDx[9] = {-1, 0, 1, -1, 0, 1, -1, 0, 1};
-  static constexpr int8_t kNeighbourDy[9] = {-1, -1, -1, 0, 0, 0, 1, 1, 1};
+  // Offsets and packed (x, y) steps of the neighbours by mask bit (lsd_kernels.h).
+  int neighbour_offset[12];
+  uint32_t neighbour_step[12];
+  for (int bit = 0; bit < 12; ++bit) {
+    neighbour_offset[bit] = kNeighbourDy[bit] * w + kNeighbourDx[bit];
+    neighbour_step[bit] = packedStep(kNeighbourDx[bit], kNeighbourDy[bit]);
+  }
   int* region = region_.data();
-  int16_t* region_x = region_x_.data();
-  int16_t* region_y = region_y_.data();
+  RegionPixel* region_xy = region_xy_.data();
   int count = 0;
   for (int k = 0; k < candidates && count < capacity; ++k) {
     const int seed = ordered[k];
@@ -166,26 +194,20 @@ int LineSegmentDetector::detect(const cv::Mat& image, float min_length, Detected
     // norm (and so the alignment bound) only changes when a pixel joins.
     state[seed] = kUsed;
     region[0] = seed;
-    region_x[0] = static_cast<int16_t>(seed % w);
-    region_y[0] = static_cast<int16_t>(seed / w);
+    region_xy[0] = RegionPixel{static_cast<int16_t>(seed % w), static_cast<int16_t>(seed / w)};
     int size = 1;
     float sum_x = dir_x[seed], sum_y = dir_y[seed];
     float bound = cos_tau * std::sqrt(sum_x * sum_x + sum_y * sum_y);
-    // Neighbours in raster order (dy, then dx) as bits 0..8 of a mask of the free ones, read
-    // three states at a time; the set bits are then visited in the same order a plain 3x3 loop
-    // would (a neighbour can only change state when it is the one being added).
+    // The free neighbours as a bit mask (lsd_kernels.h); its set bits are visited in the order a
+    // plain 3x3 loop would (a neighbour can only change state when it is the one being added).
     for (int r = 0; r < size; ++r) {
-      const int px = region_x[r], py = region_y[r];
       const int p = region[r];
-      auto freeBits = [&](int i) {  // bits 0..2: states of i - 1, i, i + 1
-        uint32_t v;
-        std::memcpy(&v, state + i - 1, 4);
-        return (v & 1u) | ((v >> 7) & 2u) | ((v >> 14) & 4u);
-      };
+      uint32_t pixel_xy;
+      std::memcpy(&pixel_xy, &region_xy[r], sizeof(pixel_xy));
       // No edge tests: the last row and column are always used, so a region pixel is never on
       // them, and its missing neighbours read used states: the row above row 0 is the used front
       // row, and left of column 0 lies the previous row's used last column.
-      uint32_t mask = freeBits(p - w) | freeBits(p) << 3 | freeBits(p + w) << 6;
+      uint32_t mask = lsdNeighbourMask(state, p, w);
       while (mask != 0) {
         const int bit = __builtin_ctz(mask);
         mask &= mask - 1;
@@ -193,8 +215,9 @@ int LineSegmentDetector::detect(const cv::Mat& image, float min_length, Detected
         if (dir_x[q] * sum_x + dir_y[q] * sum_y < bound) continue;
         state[q] = kUsed;
         region[size] = q;
-        region_x[size] = static_cast<int16_t>(px + kNeighbourDx[bit]);
-        region_y[size] = static_cast<int16_t>(py + kNeighbourDy[bit]);
+        // x + dx >= 0 (column -1 is never free), so the packed add never borrows from y.
+        const uint32_t q_xy = pixel_xy + neighbour_step[bit];
+        std::memcpy(&region_xy[size], &q_xy, sizeof(q_xy));
         ++size;
         sum_x += dir_x[q];
         sum_y += dir_y[q];
@@ -207,6 +230,41 @@ int LineSegmentDetector::detect(const cv::Mat& image, float min_length, Detected
   return count;
 }
 
+void LineSegmentDetector::regionBox(int size, int* x_min, int* x_max, int* y_min, int* y_max) const {
+  // (x, y) pairs are interleaved int16 lanes: 4 pixels a step from lanes that start as pixel 0
+  // (which changes no extreme), the rest one by one.
+  const int16_t* xy = &region_xy_[0].x;
+  int32_t first;
+  std::memcpy(&first, xy, sizeof(first));
+  cv::v_int16x8 lo = cv::v_reinterpret_as_s16(cv::v_setall_s32(first)), hi = lo;
+  int i = 0;
+  for (; i + 4 <= size; i += 4) {
+    const cv::v_int16x8 v = cv::v_load(xy + 2 * i);
+    lo = cv::v_min(lo, v);
+    hi = cv::v_max(hi, v);
+  }
+  int16_t lo_lanes[8], hi_lanes[8];
+  cv::v_store(lo_lanes, lo);
+  cv::v_store(hi_lanes, hi);
+  int x0 = lo_lanes[0], x1 = hi_lanes[0], y0 = lo_lanes[1], y1 = hi_lanes[1];
+  for (int lane = 2; lane < 8; lane += 2) {
+    x0 = std::min<int>(x0, lo_lanes[lane]);
+    x1 = std::max<int>(x1, hi_lanes[lane]);
+    y0 = std::min<int>(y0, lo_lanes[lane + 1]);
+    y1 = std::max<int>(y1, hi_lanes[lane + 1]);
+  }
+  for (; i < size; ++i) {
+    x0 = std::min<int>(x0, region_xy_[i].x);
+    x1 = std::max<int>(x1, region_xy_[i].x);
+    y0 = std::min<int>(y0, region_xy_[i].y);
+    y1 = std::max<int>(y1, region_xy_[i].y);
+  }
+  *x_min = x0;
+  *x_max = x1;
+  *y_min = y0;
+  *y_max = y1;
+}
+
 bool LineSegmentDetector::regionToSegment(int size, float min_length, DetectedSegment* segment) const {
   // An 8-connected region of `size` pixels spans at most (size - 1) * sqrt(2) along any axis:
   // too small to reach min_length means the length test below would fail anyway.
@@ -214,22 +272,21 @@ bool LineSegmentDetector::regionToSegment(int size, float min_length, DetectedSe
   // Its extent along any unit vector is at most the diagonal of its bounding box, so a box whose
   // diagonal + 1 is below min_length fails the length test below too (same result, found with
   // integer passes instead of three passes of double sums; most regions end here on fr1/rpy).
-  int x_min = region_x_[0], x_max = x_min, y_min = region_y_[0], y_max = y_min;
-  for (int i = 1; i < size; ++i) {
-    x_min = std::min<int>(x_min, region_x_[i]);
-    x_max = std::max<int>(x_max, region_x_[i]);
-    y_min = std::min<int>(y_min, region_y_[i]);
-    y_max = std::max<int>(y_max, region_y_[i]);
-  }
+  int x_min, x_max, y_min, y_max;
+  regionBox(size, &x_min, &x_max, &y_min, &y_max);
   const double box_dx = x_max - x_min, box_dy = y_max - y_min;
-  if (std::sqrt(box_dx * box_dx + box_dy * box_dy) + 1.0 + 1e-6 < min_length) return false;  // margin: rounding
+  const double box_length = std::sqrt(box_dx * box_dx + box_dy * box_dy) + 1.0 + 1e-6;  // margin: rounding
+  if (box_length < min_length) return false;
+  // The same bound fails the thickness test below before the fit (~7 % of the fits on fr1/rpy):
+  // more than max_thickness_px pixels per unit of box_length >= length.
+  if (size > options_.max_thickness_px * box_length) return false;
   double sw = 0, cx = 0, cy = 0, gx = 0, gy = 0;
   for (int i = 0; i < size; ++i) {
     const int p = region_[i];
     const double m = magnitude_[p];
     sw += m;
-    cx += m * region_x_[i];
-    cy += m * region_y_[i];
+    cx += m * region_xy_[i].x;
+    cy += m * region_xy_[i].y;
     gx += m * dir_x_[p];
     gy += m * dir_y_[p];
   }
@@ -238,7 +295,7 @@ bool LineSegmentDetector::regionToSegment(int size, float min_length, DetectedSe
   double sxx = 0, syy = 0, sxy = 0;
   for (int i = 0; i < size; ++i) {
     const int p = region_[i];
-    const double m = magnitude_[p], dx = region_x_[i] - cx, dy = region_y_[i] - cy;
+    const double m = magnitude_[p], dx = region_xy_[i].x - cx, dy = region_xy_[i].y - cy;
     sxx += m * dx * dx;
     syy += m * dy * dy;
     sxy += m * dx * dy;
@@ -254,7 +311,7 @@ bool LineSegmentDetector::regionToSegment(int size, float min_length, DetectedSe
   double l_min = 1e30, l_max = -1e30, across2 = 0;
   for (int i = 0; i < size; ++i) {
     const int p = region_[i];
-    const double dx = region_x_[i] - cx, dy = region_y_[i] - cy;
+    const double dx = region_xy_[i].x - cx, dy = region_xy_[i].y - cy;
     const double along = dx * ux + dy * uy, across = -dx * uy + dy * ux;
     l_min = std::min(l_min, along);
     l_max = std::max(l_max, along);

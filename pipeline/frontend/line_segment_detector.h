@@ -50,6 +50,7 @@ class LineSegmentDetector {
 
  private:
   bool regionToSegment(int region_size, float min_length, DetectedSegment* segment) const;
+  void regionBox(int region_size, int* x_min, int* x_max, int* y_min, int* y_max) const;
 
   LineSegmentDetectorOptions options_;
   int max_width_, max_height_;
@@ -65,7 +66,10 @@ class LineSegmentDetector {
   Scratch<int> candidate_;                        // candidates in raster order ...
   Scratch<uint16_t> candidate_bin_;               // ... and their magnitude bins
   Scratch<int> region_;                           // pixel indices of the growing region
-  Scratch<int16_t> region_x_, region_y_;          // ... and their coordinates (no divisions)
+  struct RegionPixel {
+    int16_t x, y;
+  };
+  Scratch<RegionPixel> region_xy_;                // ... and their coordinates (no divisions)
 };
 
 }  // namespace plumb

@@ -269,11 +269,13 @@ Descriptor256 referenceLineDescriptor(const cv::Mat& image, cv::Point2f start, c
 
 TEST(FrontendKernels, LineDescriptorEqualsItsScalarDefinition) {
   const cv::Mat img = testImage(320, 240, 13);
-  const LineDescriptorOptions options;
+  LineDescriptorOptions options;
   cv::RNG rng(14);
   int distinct = 0;
   Descriptor256 previous;
   for (int i = 0; i < 300; ++i) {
+    // The default band width (row weights from a table) and two others (computed per row).
+    options.band_width = i % 10 == 8 ? 2 : (i % 10 == 9 ? 4 : 3);
     // Segments of every direction and length, some reaching past the image border.
     const cv::Point2f start(rng.uniform(-10.f, 330.f), rng.uniform(-10.f, 250.f));
     const float angle = rng.uniform(0.f, static_cast<float>(2 * M_PI)), length = rng.uniform(5.f, 120.f);
