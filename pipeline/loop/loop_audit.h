@@ -28,6 +28,8 @@ struct LoopAuditEntry {
   int point_inliers = 0;        // after refinement
   int line_matches = 0;         // LBD matches whose samples entered the refinement
   int line_sample_inliers = 0;  // line-guidance samples inlying after refinement
+  int unreliable_features = 0;  // features taken out of the refinement for their leverage
+  double max_leverage = 0;      // largest feature leverage of the final refinement (0: not reached)
   double correction_m = 0;      // the correction the loop implies at the query keyframe
   double correction_deg = 0;
   double chi2 = 0;              // plausibility chi-square (6 dof)

@@ -84,7 +84,7 @@ std::size_t LoopCloser::memoryBytesFor(const LoopCloserOptions& o) {
   return sizeof(LoopCloser) + slots * (sizeof(LoopCandidate) + sizeof(Node) + 2 * sizeof(int)) +
          std::size_t(o.max_loop_edges) * sizeof(LoopEdge) +
          KeyframeDatabase::memoryBytesFor(databaseOptions(o)) + graph + sparse + sizeof(LoopVerifier) +
-         110 * 1024 +  // verifier scratch (~105 KB)
+         LoopVerifier::scratchBytes() +
          slots * sizeof(Eigen::Isometry3d) +  // poses before an optimisation (rollback)
          2 * slots * sizeof(Eigen::Vector3d) +  // the real-time anchor's fit (outputFit)
          LoopContextCheck::scratchBytes() +
@@ -261,6 +261,8 @@ void LoopCloser::detect(const LoopKeyframe& query_record, int query_position) {
     entry.point_inliers = m.refined_inliers;
     entry.line_matches = m.line_matches;
     entry.line_sample_inliers = m.line_inliers;
+    entry.unreliable_features = m.unreliable_features;
+    entry.max_leverage = m.max_leverage;
     entry.correction_m = entry.correction_deg = entry.chi2 = std::numeric_limits<double>::quiet_NaN();
     const Matrix6d covariance =
         0.5 * (m.covariance + m.covariance.transpose()) +

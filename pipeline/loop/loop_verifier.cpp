@@ -6,6 +6,7 @@
 
 #include "pipeline/frontend/descriptor_match.h"
 #include "solver/factors.h"
+#include "solver/pose_leverage.h"
 #include "solver/pose_optimizer.h"
 #include "solver/se3_jacobians.h"
 #include "solver/variance_factor.h"
@@ -48,7 +49,17 @@ struct LoopVerifier::Scratch {
   std::array<bool, kMaxLoopPoints> pose_point_inlier{};
   std::array<PoseLineObservation, kMaxLoopLines * kMaxLineSamples> pose_lines{};
   std::array<bool, kMaxLoopLines * kMaxLineSamples> pose_line_inlier{};
+  // Reliability (weakestFeature): the line each sample belongs to (a line's samples are
+  // contiguous), the union-find parent and root of each point observation (its feature).
+  std::array<uint8_t, kMaxLoopLines * kMaxLineSamples> line_of_sample{};
+  std::array<int16_t, kMaxLoopPoints> feature_parent{};
+  std::array<bool, kMaxLoopPoints> keep{};
+  std::array<Eigen::Vector2d, kMaxLoopPoints> candidate_px{};
+  std::array<int16_t, kMaxLoopPoints> feature_root{};
+  std::array<int16_t, kMaxLoopPoints> by_feature{};  // inliers ordered by (feature, index)
 };
+static_assert(kMaxLoopLines <= 256, "line_of_sample is a uint8_t");
+static_assert(kMaxLoopPoints <= 32767, "feature_parent is an int16_t");
 
 Eigen::Matrix3d LoopVerifier::candidateCovarianceInQuery(const Eigen::Vector3d& P_candidate, int octave,
                                                          const Eigen::Isometry3d& T_query_candidate) const {
@@ -66,6 +77,8 @@ LoopVerifier::LoopVerifier(const CameraIntrinsics& camera, const NoiseModelOptio
     : camera_(camera), noise_(noise), options_(options), s_(std::make_unique<Scratch>()) {}
 
 LoopVerifier::~LoopVerifier() = default;
+
+std::size_t LoopVerifier::scratchBytes() { return sizeof(Scratch); }
 
 bool LoopVerifier::lineAgrees(const LoopLine& query_line, const Eigen::Vector3f* candidate_samples,
                               std::size_t count, const Eigen::Isometry3d& T_query_candidate) const {
@@ -98,6 +111,97 @@ bool LoopVerifier::lineAgrees(const LoopLine& query_line, const Eigen::Vector3f*
   }
   const bool overlap = c_lo <= q_hi && q_lo <= c_hi;
   return overlap && double(close) >= options_.line_gate_min_fraction * double(count);
+}
+
+double LoopVerifier::weakestFeature(const PoseResult& pose, int num_points, int num_lines,
+                                    const PoseOptimizerOptions& pose_options, int* feature) const {
+  Scratch& s = *s_;
+  auto root = [&s](int i) {
+    while (s.feature_parent[std::size_t(i)] != i) i = s.feature_parent[std::size_t(i)];
+    return i;
+  };
+  // Features: inliers whose query pixels or candidate pixels are within same_feature_px (union by
+  // the smaller index, so the grouping does not depend on the visiting order).
+  const double r2 = options_.same_feature_px * options_.same_feature_px;
+  for (int i = 0; i < num_points; ++i) {
+    const std::size_t u = std::size_t(i);
+    s.feature_parent[u] = int16_t(i);
+    if (!s.pose_point_inlier[u]) continue;
+    const Eigen::Vector2d q_i = s.pose_points[u].z.head<2>();
+    s.candidate_px[u] = projectToPixel(camera_, s.pose_points[u].P_world);
+    for (int j = 0; j < i; ++j) {
+      const std::size_t v = std::size_t(j);
+      if (!s.pose_point_inlier[v]) continue;
+      if ((q_i - s.pose_points[v].z.head<2>()).squaredNorm() > r2 &&
+          (s.candidate_px[u] - s.candidate_px[v]).squaredNorm() > r2)
+        continue;
+      const int a = root(i), b = root(j);
+      if (a != b) s.feature_parent[std::size_t(std::max(a, b))] = int16_t(std::min(a, b));
+    }
+  }
+  // Each feature's information summed over its inliers in index order, one feature after the
+  // other (no per-feature storage).
+  int inliers = 0;
+  for (int i = 0; i < num_points; ++i) {
+    if (!s.pose_point_inlier[std::size_t(i)]) continue;
+    s.feature_root[std::size_t(i)] = int16_t(root(i));
+    s.by_feature[std::size_t(inliers++)] = int16_t(i);
+  }
+  std::sort(s.by_feature.begin(), s.by_feature.begin() + inliers, [&s](int16_t a, int16_t b) {
+    const int16_t ra = s.feature_root[std::size_t(a)], rb = s.feature_root[std::size_t(b)];
+    return ra != rb ? ra < rb : a < b;
+  });
+  double worst = 0;
+  *feature = 0;
+  auto consider = [&](const Matrix6d& information, int id) {
+    const double leverage = groupLeverage(pose.covariance, information);
+    if (leverage > worst) {
+      worst = leverage;
+      *feature = id;
+    }
+  };
+  Matrix6d information = Matrix6d::Zero();
+  for (int k = 0; k < inliers; ++k) {
+    const std::size_t i = std::size_t(s.by_feature[std::size_t(k)]);
+    information += poseInformation(camera_, pose.T_cam_world, s.pose_points[i], pose_options);
+    const bool last = k + 1 == inliers || s.feature_root[std::size_t(s.by_feature[std::size_t(k + 1)])] != s.feature_root[i];
+    if (!last) continue;
+    consider(information, s.feature_root[i]);
+    information.setZero();
+  }
+  for (int k = 0; k < num_lines; ++k) {
+    if (s.pose_line_inlier[std::size_t(k)])
+      information += poseInformation(camera_, pose.T_cam_world, s.pose_lines[std::size_t(k)], pose_options);
+    if (k + 1 < num_lines && s.line_of_sample[std::size_t(k + 1)] == s.line_of_sample[std::size_t(k)]) continue;
+    consider(information, -(int(s.line_of_sample[std::size_t(k)]) + 1));
+    information.setZero();
+  }
+  return worst;
+}
+
+void LoopVerifier::dropFeature(int feature, int* num_points, int* num_lines) const {
+  Scratch& s = *s_;
+  if (feature >= 0) {
+    // Roots first: moving observations would break the parent links.
+    for (int i = 0; i < *num_points; ++i) {
+      int r = i;
+      while (s.feature_parent[std::size_t(r)] != r) r = s.feature_parent[std::size_t(r)];
+      s.keep[std::size_t(i)] = r != feature || !s.pose_point_inlier[std::size_t(i)];
+    }
+    int n = 0;
+    for (int i = 0; i < *num_points; ++i)
+      if (s.keep[std::size_t(i)]) s.pose_points[std::size_t(n++)] = s.pose_points[std::size_t(i)];
+    *num_points = n;
+    return;
+  }
+  const int line = -feature - 1;
+  int n = 0;
+  for (int k = 0; k < *num_lines; ++k) {
+    if (int(s.line_of_sample[std::size_t(k)]) == line) continue;
+    s.pose_lines[std::size_t(n)] = s.pose_lines[std::size_t(k)];
+    s.line_of_sample[std::size_t(n++)] = s.line_of_sample[std::size_t(k)];
+  }
+  *num_lines = n;
 }
 
 Matrix6d LoopVerifier::calibratedCovariance(const PoseResult& pose, const PoseOptimizerOptions& pose_options) const {
@@ -214,10 +318,11 @@ LoopMeasurement LoopVerifier::verify(const LoopKeyframe& query, const LoopCandid
       const std::size_t count = candidate.num_samples[std::size_t(j)];
       const LoopLine& q = query.lines[k];
       if (!lineAgrees(q, &candidate.samples_cam[first], count, T_qc)) continue;
-      ++m.line_matches;
+      const uint8_t line_index = uint8_t(m.line_matches++);
       const double per_line = options_.line_information_per_line ? double(count) : 1.0;
       const double query_variance = 1.0 / lineSampleInformation(noise_, q.octave);
       for (std::size_t smp = 0; smp < count; ++smp) {
+        s.line_of_sample[std::size_t(num_lines)] = line_index;
         PoseLineObservation& obs = s.pose_lines[std::size_t(num_lines++)];
         obs.P_world = candidate.samples_cam[first + smp].cast<double>();
         obs.line = q.l.cast<double>();
@@ -235,14 +340,29 @@ LoopMeasurement LoopVerifier::verify(const LoopKeyframe& query, const LoopCandid
     }
   }
   PoseOptimizerOptions pose_options;
-  const PoseResult pose = optimizePose(
-      camera_, T_cq.inverse(), s.pose_points.data(), num_points, s.pose_lines.data(), num_lines, pose_options,
-      s.pose_point_inlier.data(), num_lines > 0 ? s.pose_line_inlier.data() : nullptr);
-  m.refined_inliers = pose.num_point_inliers;
-  m.line_inliers = pose.num_line_inliers;
-  if (m.refined_inliers < options_.min_refined_inliers || !pose.covariance_valid) {
-    m.rejection = LoopRejection::kRefinement;
-    return m;
+  auto refine = [&](const Eigen::Isometry3d& T_query_candidate) {
+    return optimizePose(camera_, T_query_candidate, s.pose_points.data(), num_points, s.pose_lines.data(), num_lines,
+                        pose_options, s.pose_point_inlier.data(), num_lines > 0 ? s.pose_line_inlier.data() : nullptr);
+  };
+  PoseResult pose = refine(T_qc);
+  // 4. Reliability: no single feature may carry the pose (options: max_feature_leverage).
+  for (;;) {
+    m.refined_inliers = pose.num_point_inliers;
+    m.line_inliers = pose.num_line_inliers;
+    if (m.refined_inliers < options_.min_refined_inliers || !pose.covariance_valid) {
+      m.rejection = LoopRejection::kRefinement;
+      return m;
+    }
+    int feature = 0;
+    m.max_leverage = weakestFeature(pose, num_points, num_lines, pose_options, &feature);
+    if (m.max_leverage <= options_.max_feature_leverage) break;
+    if (m.unreliable_features >= options_.max_unreliable_features) {
+      m.rejection = LoopRejection::kUncertain;
+      return m;
+    }
+    dropFeature(feature, &num_points, &num_lines);
+    ++m.unreliable_features;
+    pose = refine(pose.T_cam_world);
   }
   m.T_candidate_query = pose.T_cam_world.inverse();
   m.covariance = calibratedCovariance(pose, pose_options);

@@ -13,6 +13,7 @@
 // the odometry covariance between the two keyframes.
 // Scratch allocated at construction; verify() allocates nothing. Deterministic.
 #include <Eigen/Geometry>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 
@@ -55,6 +56,19 @@ struct LoopVerifierOptions {
   int min_inliers = 35;           // RANSAC inliers
   double min_inlier_ratio = 0.3;  // RANSAC inliers / matches
   int min_refined_inliers = 35;   // point inliers after refinement
+  // Reliability of the refinement (docs/LOOP.md "A loop that hinges on one feature"). A
+  // feature's leverage (solver/pose_leverage.h) is the share of the pose's information, in its
+  // best-determined direction, that the feature alone supplies; above 0.5 an error in it that the
+  // inlier gate cannot see moves the pose by more than that gate in its own sigmas, so the
+  // covariance no longer describes the pose. Such a feature (typically the one near point of a
+  // view of a far wall: it alone fixes the translation) is taken out and the refinement solved
+  // again without it, up to `max_unreliable_features` times; still unreliable after that, the
+  // loop is `uncertain`. A feature is the inliers whose query pixels or candidate pixels lie
+  // within `same_feature_px` of each other (one corner found at several ORB octaves, or two
+  // keypoints sharing one depth reading: not independent measurements), or one matched line.
+  double max_feature_leverage = 0.5;
+  double same_feature_px = 3.0;
+  int max_unreliable_features = 4;
   // The loop constraint's covariance (docs/LOOP.md "The loop constraint's covariance"). Both
   // ends of a loop are measurements: the candidate's 3D points and line samples come from its own
   // pixels and depth, as noisy as the query's. With `propagate_candidate_noise` each residual's
@@ -78,7 +92,8 @@ enum class LoopRejection : uint8_t {
   kLowInlierRatio,
   kRefinement,   // refinement lost the inliers (or its covariance was degenerate)
   kImplausible,  // LoopCloser: the implied correction is beyond the odometry uncertainty
-  kUncertain,    // LoopCloser: the measured relative pose is too uncertain to correct anything
+  kUncertain,    // LoopCloser: the measured relative pose is too uncertain to correct anything;
+                 // or LoopVerifier: it still hinges on single features (max_feature_leverage)
   kRolledBack,   // LoopCloser: the corrected graph explains the covisible landmarks of both sides
                  // worse than before (loop_context_check.h): undone, never published
 };
@@ -97,6 +112,8 @@ struct LoopMeasurement {
   int refined_inliers = 0;
   int line_matches = 0;  // LBD matches that passed the gate at the RANSAC pose
   int line_inliers = 0;   // their samples inlying after refinement
+  int unreliable_features = 0;  // features taken out of the refinement for their leverage
+  double max_leverage = 0;      // the largest feature leverage of the final refinement
   bool accepted() const { return rejection == LoopRejection::kNone; }
 };
 
@@ -111,6 +128,8 @@ class LoopVerifier {
   // The candidate as the closer stores it (LoopCandidate: makeLoopCandidate of its record).
   LoopMeasurement verify(const LoopKeyframe& query, const LoopCandidate& candidate);
   const LoopVerifierOptions& options() const { return options_; }
+  // The scratch allocated at construction (behind a pointer: not in sizeof(LoopVerifier)).
+  static std::size_t scratchBytes();
 
  private:
   // The gate of a line match (options above), at the RANSAC pose.
@@ -120,6 +139,12 @@ class LoopVerifier {
   // camera; zero when propagation is off or the depth is invalid.
   Eigen::Matrix3d candidateCovarianceInQuery(const Eigen::Vector3d& P_candidate, int octave,
                                              const Eigen::Isometry3d& T_query_candidate) const;
+  // The feature (group of point inliers, or one line) with the largest leverage in `pose`; its
+  // point group's representative (>= 0) or -(line + 1) in *feature.
+  double weakestFeature(const PoseResult& pose, int num_points, int num_lines, const PoseOptimizerOptions& pose_options,
+                        int* feature) const;
+  // Drops the observations of `feature` (weakestFeature's) from the refinement's arrays.
+  void dropFeature(int feature, int* num_points, int* num_lines) const;
   // The refinement's covariance, calibrated (options above).
   Matrix6d calibratedCovariance(const PoseResult& pose, const PoseOptimizerOptions& pose_options) const;
   struct Scratch;

@@ -38,6 +38,8 @@ std::string loopAuditJson(const LoopRunResult& loop) {
     append(&out, "\"score\": %s, \"matches\": %d, \"ransac_inliers\": %d, \"point_inliers\": %d, ",
            number(e.place_score, "%.4f").c_str(), e.matches, e.ransac_inliers, e.point_inliers);
     append(&out, "\"line_matches\": %d, \"line_sample_inliers\": %d, ", e.line_matches, e.line_sample_inliers);
+    append(&out, "\"unreliable_features\": %d, \"max_leverage\": %s, ", e.unreliable_features,
+           number(e.max_leverage, "%.3f").c_str());
     append(&out, "\"correction_m\": %s, \"correction_deg\": %s, \"chi2\": %s, \"outcome\": %s",
            number(e.correction_m, "%.5f").c_str(), number(e.correction_deg, "%.4f").c_str(),
            number(e.chi2, "%.4g").c_str(), runtime::jsonString(loop::toString(e.outcome)).c_str());

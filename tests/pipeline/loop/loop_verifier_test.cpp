@@ -188,6 +188,83 @@ TEST(LoopVerifier, CovarianceDescribesTheErrorsWhenBothEndsAreNoisy) {
   EXPECT_GT(without, 1.5);
 }
 
+// A loop that hinges on one feature (docs/LOOP.md "A loop that hinges on one feature"): a far wall
+// (5-7.5 m, depth sigma ~5 cm) and one near corner at 0.9 m whose depth (sigma 1.2 mm) alone fixes
+// the translation along the optical axis. In the query that corner is found twice (two ORB octaves,
+// 0.8 px apart, both matched to the candidate's one point) and its depth is read 1 cm off (a
+// depth edge). The pose absorbs the error, so the corner's residual stays small and it stays an
+// inlier, and the covariance, which trusts it, puts the loop far outside 3 sigma
+// (synth:office_loop:4 with noise: 7.2 mm off, 7.2 sigma). Taking out the feature whose leverage
+// exceeds 0.5 leaves the far wall, whose covariance describes its error.
+double hingedLoopChi2(const loop::LoopVerifierOptions& options, uint64_t seed, loop::LoopMeasurement* out) {
+  const Eigen::Isometry3d Ta = Eigen::Isometry3d::Identity();
+  Scene scene = makeScene(31, 150, 0, Ta, 5.0, 7.5);
+  const PinholeCamera pinhole = syntheticCamera();
+  ScenePoint corner = scene.points.back();
+  std::mt19937_64 descriptor_rng(77);
+  corner.descriptor = randomDescriptor(descriptor_rng);
+  corner.P_world = Ta * pinhole.unproject(400, 300, 0.9);
+  corner.response = 1000;  // kept in the record whatever else is
+  scene.points.push_back(corner);
+  const Eigen::Isometry3d Tb = pose(2, Eigen::Vector3d(0.3, -0.2, 0.5), Eigen::Vector3d(0.01, 0.015, -0.005));
+  const CameraIntrinsics camera = intrinsicsOf(pinhole);
+  const NoiseModelOptions noise;
+  std::mt19937_64 rng(seed);
+  auto a = recordOf(scene, 1, Ta, Ta, 0, Eigen::Isometry3d::Identity());
+  auto b = recordOf(scene, 50, Tb, Tb, 0, Eigen::Isometry3d::Identity());
+  addModelNoise(a.get(), camera, noise, rng);
+  addModelNoise(b.get(), camera, noise, rng);
+  std::size_t near = b->points.size();
+  for (std::size_t k = 0; k < b->points.size(); ++k)
+    if (b->points[k].P_cam.z() < 2.f) near = k;
+  EXPECT_LT(near, b->points.size());
+  if (near == b->points.size()) return INFINITY;
+  // The depth edge: the corner read 1 cm deeper, and the same corner again one octave up.
+  loop::LoopPoint& p = b->points[near];
+  const float z = p.P_cam.z() + 0.01f;
+  p.P_cam *= z / p.P_cam.z();
+  p.u_right = float(p.px.x() - camera.bf / z);
+  loop::LoopPoint twin = p;
+  twin.px += Eigen::Vector2f(0.6f, 0.5f);
+  twin.u_right += 0.6f;
+  twin.octave = 1;
+  (void)b->points.push_back(twin);
+  (void)b->point_descriptors.push_back(b->point_descriptors[near]);
+  loop::LoopVerifier verifier(camera, noise, options);
+  *out = verifier.verify(*b, *candidateOf(*a));
+  if (!out->accepted()) return 0;
+  const Eigen::Isometry3d T_qc_true = (Ta.inverse() * Tb).inverse();
+  const Vector6d e = logSE3(out->T_candidate_query.inverse() * T_qc_true.inverse());
+  return e.dot(out->covariance.ldlt().solve(e));
+}
+
+TEST(LoopVerifier, ALoopThatHingesOnOneFeatureIsMeasuredWithoutIt) {
+  loop::LoopVerifierOptions trusting;
+  trusting.max_feature_leverage = 1.01;  // leverage is at most 1: the check off
+  const loop::LoopVerifierOptions reliable;
+  const double chi2_3_sigma = 20.06;  // plumb eval --loops: 6 dof, 99.73 %
+  int wrong_trusting = 0, wrong_reliable = 0, accepted_reliable = 0;
+  for (uint64_t seed = 1; seed <= 6; ++seed) {
+    loop::LoopMeasurement m;
+    const double chi2_trusting = hingedLoopChi2(trusting, seed, &m);
+    EXPECT_TRUE(m.accepted()) << loop::toString(m.rejection);
+    EXPECT_GT(m.max_leverage, 0.5);  // the corner's
+    wrong_trusting += chi2_trusting > chi2_3_sigma;
+    const double chi2_reliable = hingedLoopChi2(reliable, seed, &m);
+    std::printf("seed %d: chi2 %.1f trusting the corner, %.1f without it (%s, %d feature(s) out, leverage %.2f)\n",
+                int(seed), chi2_trusting, chi2_reliable, loop::toString(m.rejection), m.unreliable_features,
+                m.max_leverage);
+    accepted_reliable += m.accepted();
+    wrong_reliable += chi2_reliable > chi2_3_sigma;
+    if (!m.accepted()) continue;
+    EXPECT_GE(m.unreliable_features, 1);
+    EXPECT_LE(m.max_leverage, reliable.max_feature_leverage);
+  }
+  EXPECT_GE(wrong_trusting, 5);
+  EXPECT_EQ(wrong_reliable, 0);
+  EXPECT_GE(accepted_reliable, 5);  // the far wall alone is still a loop
+}
+
 // Repeated furniture: most points of the candidate view have an identical copy 1.75 m to the side
 // (same descriptor), listed first so that it is the nearest descriptor on the tie. The ratio test
 // cannot tell a point from its copy and drops it; with both as RANSAC hypotheses the geometry of
