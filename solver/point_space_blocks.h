@@ -12,62 +12,86 @@
 // which is about half the flops of forming the R x 6 and R x 3 Jacobians and their products.
 #include <Eigen/Core>
 
+#include "solver/schur_kernels.h"
 #include "solver/types.h"
 
 namespace plumb {
 
-// Sums A^T M A and A^T q over observations, on scalars of the symmetric halves.
+// Sums A^T M A and A^T q over observations: the upper triangle of the 6x6 sum, packed by columns
+// into pairs of rows on 2-double vectors (schur_kernels.h's Double2: SSE2 on x86-64, NEON on
+// aarch64), 12 pairs and 3 for the gradient:
+//   column 0: h[0] = (0, 1*)   column 1: h[1] = (0, 1)   column 2: h[2] = (0, 1), h[3] = (2, 3*)
+//   column 3: h[4] = (0, 1), h[5] = (2, 3)    column 4: h[6] = (0, 1), h[7] = (2, 3), h[8] = (4, 5*)
+//   column 5: h[9] = (0, 1), h[10] = (2, 3), h[11] = (4, 5)        (* a lower entry, never read)
+// Every entry of the upper triangle is the same product or difference, added in the same order,
+// as in the scalar form this replaced (kept as the reference in tests/solver/schur_kernels_test.cpp,
+// which compares the two bit for bit), so results are unchanged; it runs for every observation of
+// every pose-only and local-BA linearisation, and the pairs halve the multiplies and additions and
+// the loads and stores of the sums (27 scalars were kept in memory).
 class PoseNormalAccumulator {
  public:
   void add(const Eigen::Matrix3d& M, const Eigen::Vector3d& q, const Eigen::Vector3d& P) {
+    using namespace schur_detail;
     const double x = P.x(), y = P.y(), z = P.z();
+    // The upper triangle of M by columns: (m00, *), (m01, m11), (m02, m12), m22 (element reads, not
+    // vector loads, so that an M the caller has in registers is not stored first).
     const double m00 = M(0, 0), m01 = M(0, 1), m02 = M(0, 2), m11 = M(1, 1), m12 = M(1, 2), m22 = M(2, 2);
-    // N = M (-[P]x); the columns of -[P]x are (0, -z, y), (z, 0, -x), (-y, x, 0).
-    const double n00 = y * m02 - z * m01, n01 = z * m00 - x * m02, n02 = x * m01 - y * m00;
-    const double n10 = y * m12 - z * m11, n11 = z * m01 - x * m12, n12 = x * m11 - y * m01;
+    const Double2 c0 = Double2{m00, 0.0}, c1 = Double2{m01, m11}, c2 = Double2{m02, m12};
+    // N = M (-[P]x), by columns of its rows 0 and 1: n.0 = y m.2 - z m.1, n.1 = z m.0 - x m.2,
+    // n.2 = x m.1 - y m.0 (the upper entries of M: m10 read as m01); row 2 as scalars.
+    const Double2 r0_01 = Double2{m00, m01};
+    const Double2 n0 = splat(y) * c2 - splat(z) * c1;     // (n00, n10)
+    const Double2 n1 = splat(z) * r0_01 - splat(x) * c2;  // (n01, n11)
+    const Double2 n2 = splat(x) * c1 - splat(y) * r0_01;  // (n02, n12)
     const double n20 = y * m22 - z * m12, n21 = z * m02 - x * m22, n22 = x * m12 - y * m02;
-    tt_[0] += m00, tt_[1] += m01, tt_[2] += m02, tt_[3] += m11, tt_[4] += m12, tt_[5] += m22;
-    tr_[0] += n00, tr_[1] += n01, tr_[2] += n02;
-    tr_[3] += n10, tr_[4] += n11, tr_[5] += n12;
-    tr_[6] += n20, tr_[7] += n21, tr_[8] += n22;
     // [P]x N, upper triangle: row 0 = y N_2. - z N_1., row 1 = z N_0. - x N_2., row 2 = x N_1. - y N_0.
-    rr_[0] += y * n20 - z * n10, rr_[1] += y * n21 - z * n11, rr_[2] += y * n22 - z * n12;
-    rr_[3] += z * n01 - x * n21, rr_[4] += z * n02 - x * n22;
-    rr_[5] += x * n12 - y * n02;
-    g_[0] += q.x(), g_[1] += q.y(), g_[2] += q.z();
-    g_[3] += y * q.z() - z * q.y(), g_[4] += z * q.x() - x * q.z(), g_[5] += x * q.y() - y * q.x();
+    const Double2 rr01 = splat(y) * Double2{n20, n21} - splat(z) * Double2{n0[1], n1[1]};  // (rr00, rr01)
+    const double rr02 = y * n22 - z * n2[1];
+    const double rr11 = z * n1[0] - x * n21;
+    const Double2 rr12_22 = Double2{z, x} * n2 - Double2{x, y} * Double2{n22, n2[0]};  // (rr12, rr22)
+    h_[0] += c0, h_[1] += c1, h_[2] += c2, h_[3] += Double2{m22, 0.0};
+    h_[4] += n0, h_[5] += Double2{n20, rr01[0]};
+    h_[6] += n1, h_[7] += Double2{n21, rr01[1]}, h_[8] += Double2{rr11, 0.0};
+    h_[9] += n2, h_[10] += Double2{n22, rr02}, h_[11] += rr12_22;
+    // A^T q = (q, P x q).
+    const double qx = q.x(), qy = q.y(), qz = q.z();
+    g_[0] += Double2{qx, qy};
+    g_[1] += Double2{qz, y * qz - z * qy};
+    g_[2] += Double2{z, x} * Double2{qx, qy} - Double2{x, y} * Double2{qz, qx};
   }
-  // The same for a rank-one A^T M A = u v^T (u = c v, so the product is symmetric) and A^T q = g.
+  // The same for a rank-one A^T M A = u v^T (u = c v, so the product is symmetric) and A^T q = g:
+  // column j gets the row pairs of u times v_j.
   void addRankOne(const Vector6d& u, const Vector6d& v, const Vector6d& g) {
-    tt_[0] += u(0) * v(0), tt_[1] += u(0) * v(1), tt_[2] += u(0) * v(2);
-    tt_[3] += u(1) * v(1), tt_[4] += u(1) * v(2), tt_[5] += u(2) * v(2);
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) tr_[3 * r + c] += u(r) * v(3 + c);
-    }
-    rr_[0] += u(3) * v(3), rr_[1] += u(3) * v(4), rr_[2] += u(3) * v(5);
-    rr_[3] += u(4) * v(4), rr_[4] += u(4) * v(5), rr_[5] += u(5) * v(5);
-    for (int i = 0; i < 6; ++i) g_[i] += g(i);
+    using namespace schur_detail;
+    const Double2 u01 = load2(u.data()), u23 = load2(u.data() + 2), u45 = load2(u.data() + 4);
+    const double* w = v.data();
+    h_[0] += u01 * splat(w[0]);
+    h_[1] += u01 * splat(w[1]);
+    const Double2 v2 = splat(w[2]), v3 = splat(w[3]), v4 = splat(w[4]), v5 = splat(w[5]);
+    h_[2] += u01 * v2, h_[3] += u23 * v2;
+    h_[4] += u01 * v3, h_[5] += u23 * v3;
+    h_[6] += u01 * v4, h_[7] += u23 * v4, h_[8] += u45 * v4;
+    h_[9] += u01 * v5, h_[10] += u23 * v5, h_[11] += u45 * v5;
+    g_[0] += load2(g.data()), g_[1] += load2(g.data() + 2), g_[2] += load2(g.data() + 4);
   }
   // Adds (sign 1) or removes (sign -1) another accumulator's sums.
   void merge(const PoseNormalAccumulator& other, double sign) {
-    for (int i = 0; i < 6; ++i) tt_[i] += sign * other.tt_[i], rr_[i] += sign * other.rr_[i], g_[i] += sign * other.g_[i];
-    for (int i = 0; i < 9; ++i) tr_[i] += sign * other.tr_[i];
+    const schur_detail::Double2 s = schur_detail::splat(sign);
+    for (int i = 0; i < 12; ++i) h_[i] += s * other.h_[i];
+    for (int i = 0; i < 3; ++i) g_[i] += s * other.g_[i];
   }
   void finish(Matrix6d* H, Vector6d* g) const {
-    *H << tt_[0], tt_[1], tt_[2], tr_[0], tr_[1], tr_[2],  //
-        tt_[1], tt_[3], tt_[4], tr_[3], tr_[4], tr_[5],    //
-        tt_[2], tt_[4], tt_[5], tr_[6], tr_[7], tr_[8],    //
-        tr_[0], tr_[3], tr_[6], rr_[0], rr_[1], rr_[2],    //
-        tr_[1], tr_[4], tr_[7], rr_[1], rr_[3], rr_[4],    //
-        tr_[2], tr_[5], tr_[8], rr_[2], rr_[4], rr_[5];
-    *g = Eigen::Map<const Vector6d>(g_);
+    // Entry (r, c), r <= c, is lane r % 2 of pair kColumnStart[c] + r / 2; the rest mirrored.
+    static constexpr int kColumnStart[6] = {0, 1, 2, 4, 6, 9};
+    for (int c = 0; c < 6; ++c) {
+      for (int r = 0; r <= c; ++r) (*H)(r, c) = (*H)(c, r) = h_[kColumnStart[c] + r / 2][r % 2];
+    }
+    for (int i = 0; i < 6; ++i) (*g)(i) = g_[i / 2][i % 2];
   }
 
  private:
-  double tt_[6] = {};  // upper triangle of the translation block
-  double tr_[9] = {};  // translation-rotation block, row-major
-  double rr_[6] = {};  // upper triangle of the rotation block
-  double g_[6] = {};
+  schur_detail::Double2 h_[12] = {};  // upper triangle of H, column pairs (see the top)
+  schur_detail::Double2 g_[3] = {};
 };
 
 // M = J_cam^T W J_cam and q = J_cam^T W e, by columns: GCC at -O2 does not inline Eigen's small
