@@ -182,12 +182,10 @@ double LoopVerifier::weakestFeature(const PoseResult& pose, int num_points, int 
 void LoopVerifier::dropFeature(int feature, int* num_points, int* num_lines) const {
   Scratch& s = *s_;
   if (feature >= 0) {
-    // Roots first: moving observations would break the parent links.
-    for (int i = 0; i < *num_points; ++i) {
-      int r = i;
-      while (s.feature_parent[std::size_t(r)] != r) r = s.feature_parent[std::size_t(r)];
-      s.keep[std::size_t(i)] = r != feature || !s.pose_point_inlier[std::size_t(i)];
-    }
+    // The inliers' roots as weakestFeature() stored them (moving observations would break the
+    // parent links, so they are read before any observation moves).
+    for (int i = 0; i < *num_points; ++i)
+      s.keep[std::size_t(i)] = !s.pose_point_inlier[std::size_t(i)] || s.feature_root[std::size_t(i)] != feature;
     int n = 0;
     for (int i = 0; i < *num_points; ++i)
       if (s.keep[std::size_t(i)]) s.pose_points[std::size_t(n++)] = s.pose_points[std::size_t(i)];

@@ -143,7 +143,8 @@ class LoopVerifier {
   // point group's representative (>= 0) or -(line + 1) in *feature.
   double weakestFeature(const PoseResult& pose, int num_points, int num_lines, const PoseOptimizerOptions& pose_options,
                         int* feature) const;
-  // Drops the observations of `feature` (weakestFeature's) from the refinement's arrays.
+  // Drops the observations of `feature` from the refinement's arrays; called right after
+  // weakestFeature(), whose stored roots it reads.
   void dropFeature(int feature, int* num_points, int* num_lines) const;
   // The refinement's covariance, calibrated (options above).
   Matrix6d calibratedCovariance(const PoseResult& pose, const PoseOptimizerOptions& pose_options) const;

@@ -265,10 +265,12 @@ void LocalMapper::runLocalBa(int kf_slot, InsertResult* result) {
     line.end_world += shift;
   }
 
-  // Outlier observations leave the map (when enabled). A line observation goes when most of its
-  // samples fail.
+  // Outlier observations leave the map when enabled (off by default: counted in
+  // ba_outlier_flags above, not acted on). A line observation goes when most of its samples fail.
+  result->ba_outliers = 0;
+  if (!options_.mapper.remove_ba_outliers) return;
   int outliers = 0;
-  int o = options_.mapper.remove_ba_outliers ? 0 : num_obs;
+  int o = 0;
   while (o < num_obs) {
     const BaObservation& obs = ba_observations_[std::size_t(o)];
     if (!obs.is_line) {
