@@ -51,6 +51,15 @@ TEST(FrontendAllocations, ExtractionAndMatchingAllocateNothing) {
 }
 
 TEST(FrontendAllocations, WithOpenCvLsdOnlyTheLsdAllocates) {
+  // OpenCV serial, as a run session sets it (pipeline/run/run_session.cpp): the allocation count is
+  // process-wide, and OpenCV's worker threads (cvtColor's parallel_for_) otherwise add a few
+  // allocations of their own now and then, depending on timing.
+  const int opencv_threads = cv::getNumThreads();
+  cv::setNumThreads(0);
+  struct Restore {
+    int threads;
+    ~Restore() { cv::setNumThreads(threads); }
+  } restore{opencv_threads};
   auto scene = test::makeScene("textured", 32);
   ASSERT_TRUE(scene);
   const RgbdImage frame = test::renderFrame(*scene, 7);
