@@ -2,24 +2,42 @@
 
 #include <cmath>
 
+#include "solver/schur_kernels.h"
+
 namespace plumb {
 
 // Right-looking column Cholesky on the lower triangle. Column-major storage makes the inner loops
-// contiguous; for n = 60 this is ~36k multiply-adds, negligible next to the Schur products.
+// contiguous. Written on raw column pointers: Eigen's dynamic-size segment expressions set up an
+// alignment prologue and epilogue for every column of every trailing update, which was about half
+// of the instructions for n = 60 (issue 22, BA pass). Every entry gets the same operations in the
+// same order as that form (a / l_kk, then a - l_jk * l_ik for k = 0, 1, ...), so the factor is
+// bit-identical to it (tests/solver/dense_cholesky_test.cpp keeps it as the reference).
 bool choleskyInPlace(Eigen::Ref<Eigen::MatrixXd> A) {
+  using schur_detail::Double2;
   const Eigen::Index n = A.rows();
+  const Eigen::Index stride = A.outerStride();
+  double* const a = A.data();
   for (Eigen::Index k = 0; k < n; ++k) {
-    const double pivot = A(k, k);
+    double* const col_k = a + k * stride;
+    const double pivot = col_k[k];
     if (!(pivot > 0.0) || !std::isfinite(pivot)) return false;
     const double l_kk = std::sqrt(pivot);
-    A(k, k) = l_kk;
-    const Eigen::Index tail = n - k - 1;
-    if (tail == 0) break;
-    A.col(k).tail(tail) /= l_kk;
-    // Trailing update A22 -= l21 l21^T, lower triangle only, column by column.
+    col_k[k] = l_kk;
+    for (Eigen::Index i = k + 1; i < n; ++i) col_k[i] /= l_kk;
+    // Trailing update A22 -= l21 l21^T, lower triangle only, column by column: an odd first row
+    // alone, then row pairs, then an odd last row (elementwise, so the pairing changes no bits).
     for (Eigen::Index j = k + 1; j < n; ++j) {
-      const double l_jk = A(j, k);
-      A.col(j).segment(j, n - j) -= l_jk * A.col(k).segment(j, n - j);
+      const double l_jk = col_k[j];
+      double* const col_j = a + j * stride;
+      Eigen::Index i = j;
+      if ((n - i) & 1) {
+        col_j[i] -= l_jk * col_k[i];
+        ++i;
+      }
+      const Double2 l2 = schur_detail::splat(l_jk);
+      for (; i < n; i += 2) {
+        schur_detail::store2(col_j + i, schur_detail::load2(col_j + i) - l2 * schur_detail::load2(col_k + i));
+      }
     }
   }
   return true;

@@ -266,7 +266,9 @@ class LocalBundleAdjuster {
   // IRLS normal equations at the current estimate into the per-keyframe / per-landmark /
   // per-observation blocks; returns the robust cost of the valid observations.
   double linearize(const LocalBaOptions& options);
-  bool solveDamped(const LocalBaOptions& options, double lambda);
+  // Eliminates the landmarks, factorises the damped S in S_ and solves for the pose step; with
+  // back_substitute (the LM loop, computeStep) also writes every keyframe's and landmark's step.
+  bool solveDamped(const LocalBaOptions& options, double lambda, bool back_substitute = true);
   bool evaluateChi2(const Observation& obs, const Eigen::Isometry3d& T_cam_world,
                     const Eigen::Vector3d& P_world, double* chi2) const;
   double candidateCost(const LocalBaOptions& options, bool* all_valid) const;
@@ -281,7 +283,8 @@ class LocalBundleAdjuster {
   // Reserved for the worst case, written from the front: untouched slots stay out of RSS.
   std::vector<Observation, ZeroPageAllocator<Observation>> observations_;
   std::vector<int> observation_order_;  // observation indices grouped by landmark
-  std::vector<int> landmark_scratch_;   // one landmark's observations in free keyframes
+  std::vector<int> landmark_scratch_;   // one landmark's observations in free keyframes: variables
+  std::vector<Observation*> landmark_scratch_obs_;  // ... and the observations
   std::vector<int> variable_keyframe_;  // pose variable -> keyframe
   Eigen::MatrixXd S_;                   // reduced camera system / its Cholesky factor
   Eigen::VectorXd rhs_;                 // right-hand side / pose step of the reduced system

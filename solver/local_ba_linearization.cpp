@@ -77,31 +77,6 @@ bool invertLandmarkBlock(const Eigen::Matrix3d& H, double singular_threshold, Ei
 
 }  // namespace
 
-bool LocalBundleAdjuster::evaluateChi2(const Observation& obs, const Eigen::Isometry3d& T_cam_world,
-                                          const Eigen::Vector3d& P_world, double* chi2) const {
-  switch (obs.kind) {
-    case ObservationKind::kStereoPoint: {
-      Eigen::Vector3d e;
-      if (!evaluateStereoPoint(camera_, T_cam_world, P_world, obs.z, &e, nullptr, nullptr)) return false;
-      *chi2 = e.dot(obs.information * e);
-      return true;
-    }
-    case ObservationKind::kMonoPoint: {
-      Eigen::Vector2d e;
-      if (!evaluateMonoPoint(camera_, T_cam_world, P_world, obs.z.head<2>(), &e, nullptr, nullptr)) return false;
-      *chi2 = e.dot(obs.information.topLeftCorner<2, 2>() * e);
-      return true;
-    }
-    case ObservationKind::kLineSample: {
-      double e;
-      if (!evaluateLineSample(camera_, T_cam_world, P_world, obs.z, &e, nullptr, nullptr)) return false;
-      *chi2 = e * e * obs.information(0, 0);
-      return true;
-    }
-  }
-  return false;
-}
-
 // Per observation, in camera-point space (solver/point_space_blocks.h): the residual's 3x3
 // M = J_cam^T (w Omega) J_cam and q = J_cam^T (w Omega) e give the landmark block R^T M R, the
 // pose block A^T M A (summed per keyframe on the symmetric scalars) and W = A^T M R = [MR; [P]x MR].
@@ -201,7 +176,7 @@ double LocalBundleAdjuster::linearize(const LocalBaOptions& options) {
 }
 
 // Eliminates the landmarks from the damped normal equations and solves for all steps.
-bool LocalBundleAdjuster::solveDamped(const LocalBaOptions& options, double lambda) {
+bool LocalBundleAdjuster::solveDamped(const LocalBaOptions& options, double lambda, bool back_substitute) {
   const Eigen::Index dim = 6 * static_cast<Eigen::Index>(num_pose_variables_);
   auto S = S_.topLeftCorner(dim, dim);
   auto rhs = rhs_.head(dim);
@@ -215,6 +190,8 @@ bool LocalBundleAdjuster::solveDamped(const LocalBaOptions& options, double lamb
   }
 
   num_fixed_landmarks_ = 0;
+  double* const S_data = S.data();
+  const Eigen::Index stride = S.outerStride();
   for (int j = 0; j < num_landmarks_; ++j) {
     Landmark& lm = landmarks_[j];
     Eigen::Matrix3d H_damped = lm.H_point;
@@ -224,9 +201,11 @@ bool LocalBundleAdjuster::solveDamped(const LocalBaOptions& options, double lamb
       ++num_fixed_landmarks_;
       continue;
     }
-    // Gather the observations in free keyframes (contiguous ids).
+    // Gather the observations in free keyframes with their pose variables, so that the pair loops
+    // below read neither the observation order nor the keyframes again.
     const int* order = &observation_order_[lm.first_observation];
-    int* free_obs = landmark_scratch_.data();
+    Observation** free_obs = landmark_scratch_obs_.data();
+    int* free_var = landmark_scratch_.data();
     int num_free = 0;
     bool all_line_samples = true;
     for (int a = 0; a < lm.num_observations; ++a) {
@@ -234,27 +213,30 @@ bool LocalBundleAdjuster::solveDamped(const LocalBaOptions& options, double lamb
       const int v = keyframes_[obs.keyframe].variable;
       if (!obs.valid || v < 0) continue;
       all_line_samples = all_line_samples && obs.kind == ObservationKind::kLineSample;
-      free_obs[num_free++] = order[a];
+      free_obs[num_free] = &obs;
+      free_var[num_free++] = v;
     }
-    const Eigen::Index stride = S.outerStride();
-    auto block = [&S](int row_variable, int col_variable) { return &S(6 * row_variable, 6 * col_variable); };
+    // 6x6 block (row_variable, col_variable) of S.
+    auto block = [S_data, stride](int row_variable, int col_variable) {
+      return S_data + 6 * (static_cast<Eigen::Index>(row_variable) + stride * col_variable);
+    };
     if (all_line_samples) {
       // W_a = u_a r_a^T, so V_a W_b^T = u_a (r_a^T H_ll^-1 r_b) u_b^T: a scaled outer product of
       // two 6-vectors (about half the instructions of the general product); V g = u (H_ll^-1 r)^T g.
       for (int a = 0; a < num_free; ++a) {
-        Observation& obs = observations_[free_obs[a]];
+        Observation& obs = *free_obs[a];
         obs.V.col(2).head<3>().noalias() = lm.H_point_inv * obs.V.col(1).head<3>();
-        rhs.segment<6>(6 * keyframes_[obs.keyframe].variable) += obs.V.col(2).head<3>().dot(lm.g_point) * obs.V.col(0);
+        rhs.segment<6>(6 * free_var[a]) += obs.V.col(2).head<3>().dot(lm.g_point) * obs.V.col(0);
       }
       for (int a = 0; a < num_free; ++a) {
-        const Observation& obs_a = observations_[free_obs[a]];
-        const int v_a = keyframes_[obs_a.keyframe].variable;
+        const Observation& obs_a = *free_obs[a];
+        const int v_a = free_var[a];
         const double* u_a = obs_a.V.col(0).data();
         const Eigen::Vector3d r_a = obs_a.V.col(1).head<3>();
         subtractScaledOuterLower(r_a.dot(obs_a.V.col(2).head<3>()), u_a, u_a, block(v_a, v_a), stride);
         for (int b = a + 1; b < num_free; ++b) {
-          const Observation& obs_b = observations_[free_obs[b]];
-          const int v_b = keyframes_[obs_b.keyframe].variable;
+          const Observation& obs_b = *free_obs[b];
+          const int v_b = free_var[b];
           const double gamma = r_a.dot(obs_b.V.col(2).head<3>());  // r_a^T H^-1 r_b, symmetric
           const double* u_b = obs_b.V.col(0).data();
           if (v_b > v_a) {
@@ -271,18 +253,18 @@ bool LocalBundleAdjuster::solveDamped(const LocalBaOptions& options, double lamb
     }
     // V = W H_ll^-1 and the reduced right-hand side.
     for (int a = 0; a < num_free; ++a) {
-      Observation& obs = observations_[free_obs[a]];
-      formVAndRhs(obs.W, lm.H_point_inv, lm.g_point, &obs.V, rhs.data() + 6 * keyframes_[obs.keyframe].variable);
+      Observation& obs = *free_obs[a];
+      formVAndRhs(obs.W, lm.H_point_inv, lm.g_point, &obs.V, rhs.data() + 6 * free_var[a]);
     }
     // S_ab -= V_a W_b^T for every unordered pair sharing this landmark, written into the lower
     // block triangle (row block >= column block), which is all the Cholesky reads.
     for (int a = 0; a < num_free; ++a) {
-      const Observation& obs_a = observations_[free_obs[a]];
-      const int v_a = keyframes_[obs_a.keyframe].variable;
+      const Observation& obs_a = *free_obs[a];
+      const int v_a = free_var[a];
       subtractVWtLower(obs_a.V, obs_a.W, block(v_a, v_a), stride);
       for (int b = a + 1; b < num_free; ++b) {
-        const Observation& obs_b = observations_[free_obs[b]];
-        const int v_b = keyframes_[obs_b.keyframe].variable;
+        const Observation& obs_b = *free_obs[b];
+        const int v_b = free_var[b];
         if (v_b > v_a) {
           subtractVWt(obs_b.V, obs_a.W, block(v_b, v_a), stride);
         } else if (v_b < v_a) {
@@ -300,6 +282,7 @@ bool LocalBundleAdjuster::solveDamped(const LocalBaOptions& options, double lamb
     choleskySolveInPlace(S, rhs);
     if (!rhs.allFinite()) return false;
   }
+  if (!back_substitute) return true;  // computeCovariance: the factor of S is all it reads
   for (int i = 0; i < num_keyframes_; ++i) {
     Keyframe& kf = keyframes_[i];
     kf.step = kf.variable >= 0 ? Vector6d(rhs.segment<6>(6 * kf.variable)) : Vector6d::Zero();

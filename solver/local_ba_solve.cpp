@@ -4,15 +4,47 @@
 #include <cmath>
 
 #include "solver/dense_cholesky.h"
+#include "solver/factors.h"
 #include "solver/local_ba.h"
 #include "solver/se3.h"
 #include "solver/trust_region.h"
 
 namespace plumb {
 
+// chi2 of one observation at a given pose and point (false: behind the camera). Defined here, in
+// the translation unit of its three callers and forced inline (GCC kept one out-of-line copy for
+// the three call sites, a call and a switch per observation and candidate).
+__attribute__((always_inline)) inline bool LocalBundleAdjuster::evaluateChi2(const Observation& obs, const Eigen::Isometry3d& T_cam_world,
+                                          const Eigen::Vector3d& P_world, double* chi2) const {
+  switch (obs.kind) {
+    case ObservationKind::kStereoPoint: {
+      Eigen::Vector3d e;
+      if (!evaluateStereoPoint(camera_, T_cam_world, P_world, obs.z, &e, nullptr, nullptr)) return false;
+      *chi2 = e.dot(obs.information * e);
+      return true;
+    }
+    case ObservationKind::kMonoPoint: {
+      Eigen::Vector2d e;
+      if (!evaluateMonoPoint(camera_, T_cam_world, P_world, obs.z.head<2>(), &e, nullptr, nullptr)) return false;
+      *chi2 = e.dot(obs.information.topLeftCorner<2, 2>() * e);
+      return true;
+    }
+    case ObservationKind::kLineSample: {
+      double e;
+      if (!evaluateLineSample(camera_, T_cam_world, P_world, obs.z, &e, nullptr, nullptr)) return false;
+      *chi2 = e * e * obs.information(0, 0);
+      return true;
+    }
+  }
+  return false;
+}
+
 // Robust cost at the candidate estimate over the observations valid at the linearisation point.
 // *all_valid turns false when the candidate moves one of them behind its camera.
 double LocalBundleAdjuster::candidateCost(const LocalBaOptions& options, bool* all_valid) const {
+  const RobustKernel kernels[3] = {options.kernelFor(ObservationKind::kStereoPoint),
+                                   options.kernelFor(ObservationKind::kMonoPoint),
+                                   options.kernelFor(ObservationKind::kLineSample)};
   double cost = 0.0;
   *all_valid = true;
   for (int k = 0; k < num_observations_; ++k) {
@@ -23,7 +55,7 @@ double LocalBundleAdjuster::candidateCost(const LocalBaOptions& options, bool* a
       *all_valid = false;
       return cost;
     }
-    cost += 0.5 * evaluateKernel(options.kernelFor(obs.kind), chi2).rho;
+    cost += 0.5 * robustCost(kernels[static_cast<int>(obs.kind)], chi2);
   }
   return cost;
 }
@@ -36,7 +68,7 @@ double LocalBundleAdjuster::cost(const LocalBaOptions& options) const {
     if (!obs.enabled ||
         !evaluateChi2(obs, keyframes_[obs.keyframe].T_cam_world, landmarks_[obs.landmark].P_world, &chi2))
       continue;
-    cost += 0.5 * evaluateKernel(options.kernelFor(obs.kind), chi2).rho;
+    cost += 0.5 * robustCost(options.kernelFor(obs.kind), chi2);
   }
   return cost;
 }
@@ -132,7 +164,8 @@ bool LocalBundleAdjuster::computeCovariance(const LocalBaOptions& options, const
     linearized_at_estimate_ = unit_scales;
   }
   // lambda = 0: the undamped reduced system S = H_A - H_B H_C^-1 H_B^T, factorised in place.
-  if (!solveDamped(options, 0.0)) return false;
+  // (The steps are not needed: no back-substitution, poseStep()/landmarkStep() keep their values.)
+  if (!solveDamped(options, 0.0, /*back_substitute=*/false)) return false;
   const Eigen::Index dim = 6 * static_cast<Eigen::Index>(num_pose_variables_);
   choleskyInverse(S_.topLeftCorner(dim, dim), covariance_.topLeftCorner(dim, dim));
   if (!covariance_.topLeftCorner(dim, dim).allFinite()) return false;

@@ -61,6 +61,21 @@ inline RobustKernelValue evaluateKernel(const RobustKernel& kernel, double s) {
   return out;
 }
 
+// rho(s) alone, for the cost evaluations of the LM loops: the same operations as evaluateKernel's
+// rho (so the same bits; tests/solver/robust_kernel_test.cpp compares them), without rho' and rho''.
+inline double robustCost(const RobustKernel& kernel, double s) {
+  const double d2 = kernel.delta * kernel.delta;
+  switch (kernel.type) {
+    case RobustKernelType::kNone:
+      return s;
+    case RobustKernelType::kPseudoHuber:
+      return 2.0 * d2 * (std::sqrt(1.0 + s / d2) - 1.0);
+    case RobustKernelType::kHuber:
+      return s <= d2 ? s : 2.0 * kernel.delta * std::sqrt(s) - d2;
+  }
+  return s;
+}
+
 // rho(s) and the IRLS weight rho'(s) only, for the hot loops: skips rho'' and one division.
 inline void robustCostAndWeight(const RobustKernel& kernel, double s, double* rho, double* weight) {
   const double d2 = kernel.delta * kernel.delta;

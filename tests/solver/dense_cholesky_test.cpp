@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <random>
+
 #include <Eigen/Cholesky>
 
 namespace plumb {
@@ -24,6 +27,50 @@ TEST(DenseCholesky, SolvesAndInvertsInTheCornerOfALargerBuffer) {
   EXPECT_TRUE(inverse.isApprox(inverse.transpose(), 0.0));
   EXPECT_TRUE(buffer.topLeftCorner(n, n).triangularView<Eigen::Lower>().toDenseMatrix().isApprox(
       Eigen::LLT<Eigen::MatrixXd>(A).matrixL().toDenseMatrix(), 1e-12));
+}
+
+// The Eigen-expression form choleskyInPlace had before it was written on column pointers and
+// row pairs (issue 22, BA pass). The two must give the same bits: local BA's steps and
+// covariances (and so the trajectories) come from this factor.
+bool referenceCholeskyInPlace(Eigen::Ref<Eigen::MatrixXd> A) {
+  const Eigen::Index n = A.rows();
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double pivot = A(k, k);
+    if (!(pivot > 0.0) || !std::isfinite(pivot)) return false;
+    const double l_kk = std::sqrt(pivot);
+    A(k, k) = l_kk;
+    const Eigen::Index tail = n - k - 1;
+    if (tail == 0) break;
+    A.col(k).tail(tail) /= l_kk;
+    for (Eigen::Index j = k + 1; j < n; ++j) {
+      const double l_jk = A(j, k);
+      A.col(j).segment(j, n - j) -= l_jk * A.col(k).segment(j, n - j);
+    }
+  }
+  return true;
+}
+
+TEST(DenseCholesky, FactorEqualsTheEigenExpressionFormBitForBit) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int n = 1; n <= 66; n += (n < 8 ? 1 : 5)) {
+    // Odd and even sizes and corner offsets: the row pairs start at odd and even rows.
+    for (const Eigen::Index offset : {0, 1, 6}) {
+      Eigen::MatrixXd B(n, n);
+      for (Eigen::Index i = 0; i < B.size(); ++i) B(i) = u(rng);
+      const Eigen::MatrixXd A = B * B.transpose() + 0.1 * Eigen::MatrixXd::Identity(n, n);
+      Eigen::MatrixXd got = Eigen::MatrixXd::Constant(n + offset + 3, n + offset + 2, 7.0);
+      got.block(offset, offset, n, n) = A;
+      Eigen::MatrixXd expected = got;
+      ASSERT_TRUE(choleskyInPlace(got.block(offset, offset, n, n)));
+      ASSERT_TRUE(referenceCholeskyInPlace(expected.block(offset, offset, n, n)));
+#if defined(__x86_64__) && !defined(__FMA__)
+      for (Eigen::Index i = 0; i < got.size(); ++i) ASSERT_EQ(got(i), expected(i)) << n << " " << offset << " " << i;
+#else  // aarch64 GCC fuses a - l * b differently in the two forms
+      ASSERT_LT((got - expected).norm(), 1e-12 * expected.norm()) << n << " " << offset;
+#endif
+    }
+  }
 }
 
 TEST(DenseCholesky, RejectsIndefiniteMatrices) {

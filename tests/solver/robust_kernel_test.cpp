@@ -56,3 +56,24 @@ TEST(RobustKernel, PseudoHuberMatchesItsClosedForm) {
 
 }  // namespace
 }  // namespace plumb
+
+namespace plumb {
+namespace {
+
+// robustCost (the LM loops' cost-only form) is evaluateKernel's rho bit for bit: local BA's
+// step acceptance compares costs, so a different rounding would change trajectories.
+TEST(RobustKernel, CostOnlyFormEqualsEvaluateKernelRhoExactly) {
+  for (const RobustKernelType type : {RobustKernelType::kNone, RobustKernelType::kHuber, RobustKernelType::kPseudoHuber}) {
+    for (const double delta : {0.5, 1.9598, 2.4477, 2.7955}) {
+      const RobustKernel kernel{type, delta};
+      for (double s = 0.0; s < 400.0; s = s * 1.37 + 1e-3) {
+        ASSERT_EQ(robustCost(kernel, s), evaluateKernel(kernel, s).rho)
+            << static_cast<int>(type) << " delta " << delta << " s " << s;
+      }
+      ASSERT_EQ(robustCost(kernel, delta * delta), evaluateKernel(kernel, delta * delta).rho);  // the kink
+    }
+  }
+}
+
+}  // namespace
+}  // namespace plumb
