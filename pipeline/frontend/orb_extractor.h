@@ -43,9 +43,20 @@ class OrbExtractor {
   };
 
   void selectOnLevel(int level, int wanted, FrameFeatures& out);
-  // Blurs the parts of `level` the descriptors of its first `take` ranked corners read.
-  void blurAroundKeypoints(int level, int take);
-  static constexpr int kBlurTile = 8;  // px, square: 8 blurs ~7 % fewer pixels than 16 on fr1/rpy
+  // Blurs the parts of `level` the descriptors of its first `count` ranked corners read, given
+  // their orientations (keypoints[i] is ranked corner i).
+  void blurAroundKeypoints(int level, const KeypointObservation* keypoints, int count);
+  static constexpr int kBlurBand = 4;      // rows blurred on the same runs of columns
+  static constexpr int kMinBlurSpan = 16;  // px: one vector block of the blur
+  static constexpr int kBlurSpanGap = 8;   // px: runs closer than this are blurred as one
+  // Per orientation bin and phase (the keypoint's top sample row modulo kBlurBand), the columns
+  // its tests read in each of the bands_per_keypoint_ bands it touches: bit dx + reach.
+  void buildBandMasks();
+  const uint64_t* bandMasks(int bin, int phase) const {
+    return band_masks_.data() + (static_cast<size_t>(bin) * kBlurBand + phase) * bands_per_keypoint_;
+  }
+  std::vector<uint64_t> band_masks_;
+  int bands_per_keypoint_ = 0;
 
   PinholeCamera camera_;
   ExtractorOptions options_;
@@ -62,7 +73,11 @@ class OrbExtractor {
   std::vector<int> cell_start_;
   std::vector<int, ZeroPageAllocator<int>> rank_start_;
   std::vector<char> cell_has_corner_;  // per spreading cell of the current level (sized for 8 px cells)
-  std::vector<char> blur_tile_needed_;  // per kBlurTile tile of the current level
+  // The columns blurAroundKeypoints blurs in each band of kBlurBand rows of the current level,
+  // one bit each, blur_band_words_ words a band; and one band's runs of them.
+  int blur_band_words_ = 0;
+  std::vector<uint64_t> blur_band_bits_;
+  std::vector<ImagePyramid::Span> blur_spans_;
   double pyramid_ms_ = 0;
 };
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -192,30 +193,57 @@ INSTANTIATE_TEST_SUITE_P(FrontendKernels, BlurOfRectangles,
                            return info.param == ImagePyramid::BlurPath::kPortable ? "Portable" : "ByteMultiplyAdd";
                          });
 
+// Images for the orientation test: smoothed texture, raw uniform noise, and 0/255 halves split
+// left-right and top-bottom (the largest |m10| and |m01| the disc can have, where a 16-bit
+// partial sum would wrap first), plus a 0/255 checkerboard of 1 px.
+std::vector<cv::Mat> orientationTestImages() {
+  std::vector<cv::Mat> images{testImage(200, 150, 12)};
+  cv::Mat noise(120, 161, CV_8UC1);
+  cv::RNG(7).fill(noise, cv::RNG::UNIFORM, 0, 256);
+  images.push_back(noise);
+  for (int split = 0; split < 3; ++split) {
+    cv::Mat img(90, 97, CV_8UC1);
+    for (int y = 0; y < img.rows; ++y)
+      for (int x = 0; x < img.cols; ++x) {
+        const bool bright = split == 0 ? x >= img.cols / 2 : split == 1 ? y >= img.rows / 2 : (x + y) % 2 == 0;
+        img.at<uint8_t>(y, x) = bright ? 255 : 0;
+      }
+    images.push_back(img);
+    images.push_back(255 - img);
+  }
+  return images;
+}
+
 TEST(FrontendKernels, OrientationEqualsIntensityCentroidOverTheDisc) {
-  const cv::Mat img = testImage(200, 150, 12);
-  const OrbDescriber describer(static_cast<int>(img.step[0]));
   const int r = OrbDescriber::kPatchRadius;
-  int compared = 0;
-  std::array<int, 4> quadrants{};
-  for (int y = OrbDescriber::kBorder; y < img.rows - OrbDescriber::kBorder; y += 3) {
-    for (int x = OrbDescriber::kBorder; x < img.cols - OrbDescriber::kBorder; x += 5) {
-      int m10 = 0, m01 = 0;
-      for (int dy = -r; dy <= r; ++dy) {
-        const int w = static_cast<int>(std::floor(std::sqrt(double(r * r - dy * dy)) + 0.5));
-        for (int dx = -w; dx <= w; ++dx) {
-          m10 += dx * img.at<uint8_t>(y + dy, x + dx);
-          m01 += dy * img.at<uint8_t>(y + dy, x + dx);
+  for (const auto path : {OrbDescriber::OrientationPath::kPortable, OrbDescriber::OrientationPath::kByteMultiplyAdd}) {
+    SCOPED_TRACE(path == OrbDescriber::OrientationPath::kPortable ? "portable" : "byte multiply-add");
+    int compared = 0, image_index = 0;
+    std::array<int, 4> quadrants{};
+    for (const cv::Mat& img : orientationTestImages()) {
+      SCOPED_TRACE("image " + std::to_string(image_index++));
+      OrbDescriber describer(static_cast<int>(img.step[0]));
+      if (!describer.setOrientationPath(path)) GTEST_SKIP() << "no SSSE3 (or not x86-64): the portable path was checked";
+      for (int y = OrbDescriber::kBorder; y < img.rows - OrbDescriber::kBorder; y += 3) {
+        for (int x = OrbDescriber::kBorder; x < img.cols - OrbDescriber::kBorder; x += 5) {
+          int m10 = 0, m01 = 0;
+          for (int dy = -r; dy <= r; ++dy) {
+            const int w = static_cast<int>(std::floor(std::sqrt(double(r * r - dy * dy)) + 0.5));
+            for (int dx = -w; dx <= w; ++dx) {
+              m10 += dx * img.at<uint8_t>(y + dy, x + dx);
+              m01 += dy * img.at<uint8_t>(y + dy, x + dx);
+            }
+          }
+          const float expected = cv::fastAtan2(static_cast<float>(m01), static_cast<float>(m10));
+          ASSERT_EQ(describer.orientationDeg(img.ptr<uint8_t>(y) + x), expected) << "at " << x << "," << y;
+          ++quadrants[std::min(3, static_cast<int>(expected / 90))];
+          ++compared;
         }
       }
-      const float expected = cv::fastAtan2(static_cast<float>(m01), static_cast<float>(m10));
-      ASSERT_EQ(describer.orientationDeg(img.ptr<uint8_t>(y) + x), expected) << "at " << x << "," << y;
-      ++quadrants[std::min(3, static_cast<int>(expected / 90))];
-      ++compared;
     }
+    EXPECT_GT(compared, 1500);
+    for (int q : quadrants) EXPECT_GT(q, 10);  // every direction occurs
   }
-  EXPECT_GT(compared, 500);
-  for (int q : quadrants) EXPECT_GT(q, 10);  // every direction occurs
 }
 
 // The descriptor's definition, one sample at a time with plain if/else accumulation.
