@@ -126,15 +126,18 @@ PLUMB_BYTE_BLUR_INLINE void blurBytes(const uint8_t* const* rows, std::ptrdiff_t
   }
 }
 
-// Blurs [begin, end) from `rows` (offset by the column) into d: blocks of 16, the last one moved
-// back to end at `end` (recomputing a few outputs with the same values), or one or two blocks of
-// 8 when the range is 8..15 wide; returns the first column left for a scalar tail.
+// Blurs [begin, end) from `rows` (offset by the column) into d: blocks of 16, then a last block
+// of 8 or 16 moved back to end at `end` (recomputing a few outputs with the same values; 8 when
+// at most 8 columns are left: about half the work), or one or two blocks of 8 when the range is
+// 8..15 wide; returns the first column left for a scalar tail.
 PLUMB_BYTE_BLUR_INLINE int blurBlocks(const uint8_t* const* rows, int begin, int end, const ByteWeights& w, uint8_t* d) {
   if (end - begin >= 16) {
-    for (int x = begin; x < end;) {
-      const int bx = std::min(x, end - 16);
-      blurBytes<true>(rows, bx, w, d + bx);
-      x = bx + 16;
+    int x = begin;
+    for (; x + 16 <= end; x += 16) blurBytes<true>(rows, x, w, d + x);
+    if (x + 8 >= end) {
+      if (x < end) blurBytes<false>(rows, end - 8, w, d + end - 8);
+    } else {
+      blurBytes<true>(rows, end - 16, w, d + end - 16);
     }
     return end;
   }

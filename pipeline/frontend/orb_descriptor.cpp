@@ -6,19 +6,19 @@
 
 #include <opencv2/core/hal/intrin.hpp>
 
-// The byte multiply-add path of orientationDeg(): SSSE3's pmaddubsw, chosen at run time on x86-64
-// (the baseline is SSE2). Elsewhere (aarch64: NEON) the portable path alone.
+// The x86 path: SSSE3's pmaddubsw for orientationDeg(), chosen at run time on x86-64 (the baseline
+// is SSE2), and cmp + adc in describe(). Elsewhere (aarch64: NEON) the portable path alone.
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #include <tmmintrin.h>
-#define PLUMB_ORIENTATION_BYTES 1
+#define PLUMB_ORB_X86 1
 #else
-#define PLUMB_ORIENTATION_BYTES 0
+#define PLUMB_ORB_X86 0
 #endif
 
 namespace plumb {
 namespace {
 
-#if PLUMB_ORIENTATION_BYTES
+#if PLUMB_ORB_X86
 bool cpuHasSsse3() {
   static const bool has = __builtin_cpu_supports("ssse3");
   return has;
@@ -102,7 +102,7 @@ OrbDescriber::OrbDescriber(int stride) : stride_(stride) {
       y_weight_bytes_[dy][i] = static_cast<int8_t>(y_weight_[dy][i]);
     }
   }
-  setOrientationPath(OrientationPath::kByteMultiplyAdd);  // where the CPU has it
+  setKernelPath(KernelPath::kX86);  // where the CPU has it
   constexpr double kSigma = 31.0 / 5.0;
   constexpr double kMaxRadius = 13.0;
   std::array<double, 1024> pattern{};  // x0 y0 x1 y1 per test
@@ -150,19 +150,19 @@ int OrbDescriber::angleBin(float angle_deg) {
   return bin;
 }
 
-bool OrbDescriber::setOrientationPath(OrientationPath path) {
-#if PLUMB_ORIENTATION_BYTES
-  if (path == OrientationPath::kByteMultiplyAdd && !cpuHasSsse3()) return false;
+bool OrbDescriber::setKernelPath(KernelPath path) {
+#if PLUMB_ORB_X86
+  if (path == KernelPath::kX86 && !cpuHasSsse3()) return false;
 #else
-  if (path == OrientationPath::kByteMultiplyAdd) return false;
+  if (path == KernelPath::kX86) return false;
 #endif
-  orientation_path_ = path;
+  kernel_path_ = path;
   return true;
 }
 
 float OrbDescriber::orientationDeg(const uint8_t* p) const {
-#if PLUMB_ORIENTATION_BYTES
-  if (orientation_path_ == OrientationPath::kByteMultiplyAdd) {
+#if PLUMB_ORB_X86
+  if (kernel_path_ == KernelPath::kX86) {
     return orientationBytes(p, stride_, x_weight_bytes_.data(), y_weight_bytes_.data(), kPatchRadius);
   }
 #endif
@@ -198,10 +198,27 @@ void OrbDescriber::describe(const uint8_t* p, float angle_deg, Descriptor256& ou
   const int bin = angleBin(angle_deg);
   const int* first = first_offsets_[bin].data();
   const int* second = second_offsets_[bin].data();
-  // Test t is bit t % 64 of word t / 64, shifted in from the last test of a word down. Scalar
-  // compares, unrolled: ~7 instructions a test (two offsets, a byte load, a compare with memory,
-  // setb, a widening, lea); gathering 16 samples into byte vectors for one vector compare cost
-  // ~11 (GCC assembles the gathered bytes with shifts and ors).
+  // Test t is bit t % 64 of word t / 64, shifted in from the last test of a word down.
+#if PLUMB_ORB_X86
+  if (kernel_path_ == KernelPath::kX86) {
+    // cmp sets the carry exactly when p[first] < p[second] (unsigned bytes) and adc shifts it in
+    // (bits + bits + carry): 5 instructions a test (two offsets, a byte load, the compare with
+    // memory, adc) where the portable form compiles to 7 (setb, a widening and lea for the adc).
+    for (int word = 0; word < 4; ++word, first += 64, second += 64) {
+      uint64_t bits = 0;
+#pragma GCC unroll 64
+      for (int j = 63; j >= 0; --j) {
+        const uint8_t a = p[first[j]];
+        asm("cmpb %2, %1\n\tadcq %0, %0" : "+r"(bits) : "q"(a), "m"(p[second[j]]) : "cc");
+      }
+      out.words[word] = bits;
+    }
+    return;
+  }
+#endif
+  // Scalar compares, unrolled: ~7 instructions a test (two offsets, a byte load, a compare with
+  // memory, setb, a widening, lea); gathering 16 samples into byte vectors for one vector compare
+  // cost ~11 (GCC assembles the gathered bytes with shifts and ors).
   for (int word = 0; word < 4; ++word, first += 64, second += 64) {
     uint64_t bits = 0;
 #pragma GCC unroll 64

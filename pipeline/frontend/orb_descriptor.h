@@ -25,13 +25,14 @@ class OrbDescriber {
 
   // Orientation in degrees [0, 360) of the patch centred at `p` (level image, shared stride).
   float orientationDeg(const uint8_t* p) const;
-  // The centroid sums' two implementations, the same integers (so the same float): byte
-  // multiply-adds (SSSE3 pmaddubsw, x86-64 CPUs that have it, chosen at construction) or the
-  // portable 16-bit form (OpenCV's universal intrinsics: SSE2, NEON). setOrientationPath returns
-  // false, changing nothing, for a path this CPU or build does not have (tests run both).
-  enum class OrientationPath { kPortable, kByteMultiplyAdd };
-  OrientationPath orientationPath() const { return orientation_path_; }
-  bool setOrientationPath(OrientationPath path);
+  // Two implementations of both, the same integers (so the same angle and bits): the portable
+  // one (OpenCV's universal intrinsics, SSE2 or NEON, and plain C++ for the tests) and, on x86-64
+  // CPUs with SSSE3 (chosen at construction), byte multiply-adds (pmaddubsw) for the centroid
+  // sums and add-with-carry bit packing for the tests. setKernelPath returns false, changing
+  // nothing, for a path this CPU or build does not have (tests run both).
+  enum class KernelPath { kPortable, kX86 };
+  KernelPath kernelPath() const { return kernel_path_; }
+  bool setKernelPath(KernelPath path);
   // Rotated BRIEF on the blurred level at `p`.
   void describe(const uint8_t* p_blurred, float angle_deg, Descriptor256& out) const;
   // The orientation bin describe() uses for `angle_deg`.
@@ -57,7 +58,7 @@ class OrbDescriber {
   alignas(16) std::array<std::array<int16_t, 32>, kPatchRadius + 1> x_weight_{}, y_weight_{};
   // The same weights as signed bytes (|weight| <= 15) for the byte multiply-add path.
   alignas(16) std::array<std::array<int8_t, 32>, kPatchRadius + 1> x_weight_bytes_{}, y_weight_bytes_{};
-  OrientationPath orientation_path_ = OrientationPath::kPortable;
+  KernelPath kernel_path_ = KernelPath::kPortable;
 };
 
 }  // namespace plumb

@@ -46,9 +46,9 @@ class OrbExtractor {
   // Blurs the parts of `level` the descriptors of its first `count` ranked corners read, given
   // their orientations (keypoints[i] is ranked corner i).
   void blurAroundKeypoints(int level, const KeypointObservation* keypoints, int count);
-  static constexpr int kBlurBand = 4;      // rows blurred on the same runs of columns
+  static constexpr int kBlurBand = 8;      // rows blurred on the same runs of columns
   static constexpr int kMinBlurSpan = 16;  // px: one vector block of the blur
-  static constexpr int kBlurSpanGap = 8;   // px: runs closer than this are blurred as one
+  static constexpr int kBlurSpanGap = 16;  // px: runs closer than this are blurred as one
   // Per orientation bin and phase (the keypoint's top sample row modulo kBlurBand), the columns
   // its tests read in each of the bands_per_keypoint_ bands it touches: bit dx + reach.
   void buildBandMasks();

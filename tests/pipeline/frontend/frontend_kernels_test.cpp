@@ -187,6 +187,46 @@ TEST_P(BlurOfRectangles, EqualTheWholeImageBlurInsideThem) {
   }
 }
 
+TEST_P(BlurOfRectangles, RowSpansEqualTheWholeImageBlurInsideThem) {
+  // blurRowSpans (ORB's per-band blur): bands of 1 to 9 rows, each with up to 6 random spans of
+  // 1 to 70 columns, overlapping or not, at the edges and inside, on every level.
+  const cv::Mat img = testImage(643, 481, 17);
+  ImagePyramid whole(img.cols, img.rows, 8, 1.2f);
+  whole.build(img);
+  ImagePyramid parts(img.cols, img.rows, 8, 1.2f);
+  if (!parts.setBlurPath(GetParam())) GTEST_SKIP() << "this blur path does not exist on this CPU";
+  parts.buildLevels(img);
+  cv::RNG rng(5);
+  int spans_checked = 0;
+  for (int level = 0; level < 8; ++level) {
+    const cv::Mat before = parts.blurred(level).clone();
+    const int w = before.cols, h = before.rows;
+    cv::Mat written(before.size(), CV_8UC1, cv::Scalar(0));
+    for (int band = 0; band < 40; ++band) {
+      const int y0 = band == 0 ? 0 : (band == 1 ? h - 3 : rng.uniform(0, h));
+      const int y1 = std::min(h, y0 + rng.uniform(1, 10));
+      ImagePyramid::Span spans[6];
+      const int num_spans = rng.uniform(1, 7);
+      for (int i = 0; i < num_spans; ++i) {
+        const int width = std::min(w, rng.uniform(1, 71));
+        const int x0 = i == 0 && band % 3 == 0 ? 0 : (i == 1 && band % 3 == 1 ? w - width : rng.uniform(0, w - width + 1));
+        spans[i] = {x0, x0 + width};
+        written(cv::Rect(x0, y0, width, y1 - y0)).setTo(1);
+      }
+      parts.blurRowSpans(level, y0, y1, spans, num_spans);
+      for (int i = 0; i < num_spans; ++i) {
+        const cv::Rect r(spans[i].x0, y0, spans[i].x1 - spans[i].x0, y1 - y0);
+        ASSERT_EQ(cv::norm(parts.blurred(level)(r), whole.blurred(level)(r), cv::NORM_INF), 0)
+            << "level " << level << " span " << r;
+        ++spans_checked;
+      }
+    }
+    const cv::Mat untouched = written == 0;
+    EXPECT_EQ(cv::norm(parts.blurred(level), before, cv::NORM_INF, untouched), 0) << "level " << level;
+  }
+  EXPECT_GT(spans_checked, 500);
+}
+
 INSTANTIATE_TEST_SUITE_P(FrontendKernels, BlurOfRectangles,
                          ::testing::Values(ImagePyramid::BlurPath::kPortable, ImagePyramid::BlurPath::kByteMultiplyAdd),
                          [](const ::testing::TestParamInfo<ImagePyramid::BlurPath>& info) {
@@ -216,14 +256,14 @@ std::vector<cv::Mat> orientationTestImages() {
 
 TEST(FrontendKernels, OrientationEqualsIntensityCentroidOverTheDisc) {
   const int r = OrbDescriber::kPatchRadius;
-  for (const auto path : {OrbDescriber::OrientationPath::kPortable, OrbDescriber::OrientationPath::kByteMultiplyAdd}) {
-    SCOPED_TRACE(path == OrbDescriber::OrientationPath::kPortable ? "portable" : "byte multiply-add");
+  for (const auto path : {OrbDescriber::KernelPath::kPortable, OrbDescriber::KernelPath::kX86}) {
+    SCOPED_TRACE(path == OrbDescriber::KernelPath::kPortable ? "portable" : "x86");
     int compared = 0, image_index = 0;
     std::array<int, 4> quadrants{};
     for (const cv::Mat& img : orientationTestImages()) {
       SCOPED_TRACE("image " + std::to_string(image_index++));
       OrbDescriber describer(static_cast<int>(img.step[0]));
-      if (!describer.setOrientationPath(path)) GTEST_SKIP() << "no SSSE3 (or not x86-64): the portable path was checked";
+      if (!describer.setKernelPath(path)) GTEST_SKIP() << "no SSSE3 (or not x86-64): the portable path was checked";
       for (int y = OrbDescriber::kBorder; y < img.rows - OrbDescriber::kBorder; y += 3) {
         for (int x = OrbDescriber::kBorder; x < img.cols - OrbDescriber::kBorder; x += 5) {
           int m10 = 0, m01 = 0;
@@ -244,6 +284,40 @@ TEST(FrontendKernels, OrientationEqualsIntensityCentroidOverTheDisc) {
     EXPECT_GT(compared, 1500);
     for (int q : quadrants) EXPECT_GT(q, 10);  // every direction occurs
   }
+}
+
+// The x86 path's bit packing (cmp + adc) against the portable compares, every orientation bin,
+// on raw noise (many equal pairs: the strict < matters) and the smoothed test image; and the
+// bins really differ (the angle picks the pattern).
+TEST(FrontendKernels, DescriptorPathsGiveTheSameBits) {
+  std::vector<cv::Mat> images = orientationTestImages();
+  cv::Mat coarse_noise(70, 83, CV_8UC1);
+  cv::RNG(3).fill(coarse_noise, cv::RNG::UNIFORM, 0, 4);  // values 0..3: many ties
+  images.push_back(coarse_noise);
+  int compared = 0, differing_bins = 0;
+  for (const cv::Mat& img : images) {
+    OrbDescriber portable(static_cast<int>(img.step[0])), x86(static_cast<int>(img.step[0]));
+    ASSERT_TRUE(portable.setKernelPath(OrbDescriber::KernelPath::kPortable));
+    if (!x86.setKernelPath(OrbDescriber::KernelPath::kX86)) GTEST_SKIP() << "no SSSE3 (or not x86-64)";
+    for (int y = OrbDescriber::kBorder; y < img.rows - OrbDescriber::kBorder; y += 7) {
+      for (int x = OrbDescriber::kBorder; x < img.cols - OrbDescriber::kBorder; x += 11) {
+        Descriptor256 previous;
+        for (int bin = 0; bin < OrbDescriber::kAngleBins; ++bin) {
+          const float angle = bin * 360.0f / OrbDescriber::kAngleBins;
+          ASSERT_EQ(OrbDescriber::angleBin(angle), bin);
+          Descriptor256 a, b;
+          portable.describe(img.ptr<uint8_t>(y) + x, angle, a);
+          x86.describe(img.ptr<uint8_t>(y) + x, angle, b);
+          ASSERT_EQ(a.words, b.words) << "at " << x << "," << y << ", bin " << bin;
+          if (bin > 0 && a.words != previous.words) ++differing_bins;
+          previous = a;
+          ++compared;
+        }
+      }
+    }
+  }
+  EXPECT_GT(compared, 3000);
+  EXPECT_GT(differing_bins, compared / 2);
 }
 
 // The descriptor's definition, one sample at a time with plain if/else accumulation.
