@@ -25,9 +25,9 @@ class ImagePyramid {
   // grey: CV_8UC1 of the level-0 size. Fills every level and the blurred levels. `grey` may be
   // levelZero() itself (written by the caller in place: no copy).
   void build(const cv::Mat& grey);
-  // Fills the levels only; blurRect() then blurs just the parts a caller reads (ORB blurs the
-  // neighbourhoods of the keypoints it describes: ~half of the pixels on fr1/rpy). A blurred
-  // pixel has the same value either way; pixels never blurred keep older contents.
+  // Fills the levels only; blurRect() or blurRowSpans() then blurs just the parts a caller reads
+  // (ORB blurs the columns its keypoints' tests read). A blurred pixel has the same value either
+  // way; pixels never blurred keep older contents.
   void buildLevels(const cv::Mat& grey);
   // Blurs [x0, x1) x [y0, y1) of `level` (clipped to the level) into blurred(level).
   void blurRect(int level, int x0, int y0, int x1, int y1);

@@ -6,8 +6,9 @@
 // (every cell's best corner first, then every cell's second best, ...), each round strongest
 // first. FAST runs on the whole level at the high threshold, and again at the low threshold in
 // the cells that found nothing, so weak-texture regions still get keypoints (ORB-SLAM's
-// adaptive threshold). Then orientation by intensity centroid,
-// rotated BRIEF on the blurred level, and undistortion of the keypoint coordinate.
+// adaptive threshold). Then orientation by intensity centroid, the blur of just the pixels the
+// chosen keypoints' tests read (their orientation bins known), rotated BRIEF on the blurred
+// level, and undistortion of the keypoint coordinate.
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -55,8 +56,6 @@ class OrbExtractor {
   const uint64_t* bandMasks(int bin, int phase) const {
     return band_masks_.data() + (static_cast<size_t>(bin) * kBlurBand + phase) * bands_per_keypoint_;
   }
-  std::vector<uint64_t> band_masks_;
-  int bands_per_keypoint_ = 0;
 
   PinholeCamera camera_;
   ExtractorOptions options_;
@@ -78,6 +77,8 @@ class OrbExtractor {
   int blur_band_words_ = 0;
   std::vector<uint64_t> blur_band_bits_;
   std::vector<ImagePyramid::Span> blur_spans_;
+  std::vector<uint64_t> band_masks_;  // see bandMasks()
+  int bands_per_keypoint_ = 0;
   double pyramid_ms_ = 0;
 };
 
