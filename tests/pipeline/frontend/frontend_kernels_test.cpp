@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -156,18 +157,29 @@ TEST(FrontendKernels, BlurPathsEqualTheFixedPointReference) {
   if (!have_bytes) GTEST_SKIP() << "no SSSE3 (or not x86-64): only the portable blur was checked";
 }
 
-class BlurOfRectangles : public ::testing::TestWithParam<ImagePyramid::BlurPath> {};
+class BlurOfRectangles : public ::testing::TestWithParam<ImagePyramid::BlurPath> {
+ protected:
+  // whole_: a 643x481 test image's pyramid blurred everywhere; parts_: its levels only, on the
+  // blur path under test. False when this CPU or build does not have the path.
+  bool makePyramids(uint64_t seed) {
+    const cv::Mat img = testImage(643, 481, seed);
+    whole_ = std::make_unique<ImagePyramid>(img.cols, img.rows, 8, 1.2f);
+    whole_->build(img);
+    parts_ = std::make_unique<ImagePyramid>(img.cols, img.rows, 8, 1.2f);
+    if (!parts_->setBlurPath(GetParam())) return false;
+    parts_->buildLevels(img);
+    return true;
+  }
+  std::unique_ptr<ImagePyramid> whole_, parts_;
+};
 
 TEST_P(BlurOfRectangles, EqualTheWholeImageBlurInsideThem) {
   // ORB blurs only around its keypoints (ImagePyramid::blurRect): small, odd-sized rectangles
   // at the image edges and inside must get exactly the whole-image values, and nothing outside
   // them may be written.
-  const cv::Mat img = testImage(643, 481, 13);
-  ImagePyramid whole(img.cols, img.rows, 8, 1.2f);
-  whole.build(img);
-  ImagePyramid parts(img.cols, img.rows, 8, 1.2f);
-  if (!parts.setBlurPath(GetParam())) GTEST_SKIP() << "this blur path does not exist on this CPU";
-  parts.buildLevels(img);
+  if (!makePyramids(13)) GTEST_SKIP() << "this blur path does not exist on this CPU";
+  const ImagePyramid& whole = *whole_;
+  ImagePyramid& parts = *parts_;
   const cv::Rect rects[] = {{0, 0, 5, 3}, {0, 0, 16, 16}, {1, 2, 7, 9}, {30, 40, 17, 33}, {100, 7, 64, 16},
                             {200, 200, 3, 40}, {600, 450, 43, 31}, {630, 10, 13, 20}, {2, 470, 30, 11}};
   for (int level = 0; level < 8; ++level) {
@@ -190,12 +202,9 @@ TEST_P(BlurOfRectangles, EqualTheWholeImageBlurInsideThem) {
 TEST_P(BlurOfRectangles, RowSpansEqualTheWholeImageBlurInsideThem) {
   // blurRowSpans (ORB's per-band blur): bands of 1 to 9 rows, each with up to 6 random spans of
   // 1 to 70 columns, overlapping or not, at the edges and inside, on every level.
-  const cv::Mat img = testImage(643, 481, 17);
-  ImagePyramid whole(img.cols, img.rows, 8, 1.2f);
-  whole.build(img);
-  ImagePyramid parts(img.cols, img.rows, 8, 1.2f);
-  if (!parts.setBlurPath(GetParam())) GTEST_SKIP() << "this blur path does not exist on this CPU";
-  parts.buildLevels(img);
+  if (!makePyramids(17)) GTEST_SKIP() << "this blur path does not exist on this CPU";
+  const ImagePyramid& whole = *whole_;
+  ImagePyramid& parts = *parts_;
   cv::RNG rng(5);
   int spans_checked = 0;
   for (int level = 0; level < 8; ++level) {
