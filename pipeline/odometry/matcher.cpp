@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "pipeline/odometry/line_direction_bins.h"
+
 namespace plumb {
 namespace {
 
@@ -136,13 +138,18 @@ int ProjectionMatcher::matchLines(const LineCandidate* candidates, int count, co
   // Per observed line, once instead of once per candidate (the same float operations, so the
   // same values): its span, its length, and the angle test's bound.
   std::array<Eigen::Vector2f, kMaxLines> obs_spans;
-  std::array<float, kMaxLines> obs_lengths, angle_bounds;
+  obs_spans.fill(Eigen::Vector2f::Zero());  // read only below num_lines; GCC cannot tell
+  std::array<float, kMaxLines> obs_lengths{}, angle_bounds;
   for (int k = 0; k < num_lines; ++k) {
     const LineObservation& obs = frame.lines[k];
     obs_spans[k] = obs.end_px - obs.start_px;
     obs_lengths[k] = obs_spans[k].norm();
     angle_bounds[k] = cos_max_angle * obs_lengths[k];
   }
+  // Only the lines whose direction can pass the angle test are visited (line_direction_bins.h:
+  // a superset of them, in index order, so the matches are those of testing every line).
+  LineDirectionBins bins;  // 3 kB, like the arrays above
+  bins.build(obs_spans.data(), obs_lengths.data(), num_lines, 1e-3f, o.max_angle_deg);
   for (int c = 0; c < count; ++c) {
     const LineCandidate& cand = candidates[c];
     const Eigen::Vector2f span = cand.end_px - cand.start_px;
@@ -151,16 +158,16 @@ int ProjectionMatcher::matchLines(const LineCandidate* candidates, int count, co
     const Eigen::Vector2f u = span / length;
     const Eigen::Vector2f n(-u.y(), u.x());
     int best = 1 << 20, second = 1 << 20, best_line = -1;
-    for (int k = 0; k < num_lines; ++k) {
+    forEachLine(bins.near(span), [&](int k) {
       const float obs_length = obs_lengths[k];
-      if (obs_length < 1e-3f) continue;
-      if (std::abs(u.dot(obs_spans[k])) < angle_bounds[k]) continue;  // undirected angle
+      if (obs_length < 1e-3f) return;
+      if (std::abs(u.dot(obs_spans[k])) < angle_bounds[k]) return;  // undirected angle
       const LineObservation& obs = frame.lines[k];
       const Eigen::Vector2f ds = obs.start_px - cand.start_px, de = obs.end_px - cand.start_px;
-      if (std::abs(n.dot(ds)) > o.max_endpoint_distance_px || std::abs(n.dot(de)) > o.max_endpoint_distance_px) continue;
+      if (std::abs(n.dot(ds)) > o.max_endpoint_distance_px || std::abs(n.dot(de)) > o.max_endpoint_distance_px) return;
       const float t0 = std::min(u.dot(ds), u.dot(de)), t1 = std::max(u.dot(ds), u.dot(de));
       const float overlap = std::min(t1, length) - std::max(t0, 0.f);
-      if (overlap < o.min_overlap * std::min(length, obs_length)) continue;
+      if (overlap < o.min_overlap * std::min(length, obs_length)) return;
       const int d = hammingDistance(cand.descriptor, frame.line_descriptors[k]);
       if (d < best) {
         second = best;
@@ -169,7 +176,7 @@ int ProjectionMatcher::matchLines(const LineCandidate* candidates, int count, co
       } else if (d < second) {
         second = d;
       }
-    }
+    });
     if (best_line < 0 || best > o.lbd_threshold || best > o.ratio * second) continue;
     if (best < best_distance[best_line]) {
       best_distance[best_line] = best;
