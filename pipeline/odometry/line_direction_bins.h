@@ -23,7 +23,7 @@ namespace plumb {
 
 class LineDirectionBins {
  public:
-  static constexpr int kBins = 90;  // 2 deg each: ~13 % of the lines per bin at the default 10 deg
+  static constexpr int kBins = 45;  // 4 deg each: ~14 % of the lines per bin at the default 10 deg
   static constexpr double kBinDeg = 180.0 / kBins;
   static constexpr double kMarginDeg = 1.0;
   static constexpr int kWords = (kMaxLines + 63) / 64;
@@ -47,9 +47,10 @@ class LineDirectionBins {
         for (Mask& m : masks_) m[k / 64] |= bit;
         continue;
       }
+      // angle in [0, 180] and window_deg < 90: first >= -kBins, last < 2 kBins.
       const int first = int(std::floor((angle - window_deg) / kBinDeg));
       const int last = int(std::floor((angle + window_deg) / kBinDeg));
-      for (int b = first; b <= last; ++b) masks_[((b % kBins) + kBins) % kBins][k / 64] |= bit;
+      for (int b = first; b <= last; ++b) masks_[b < 0 ? b + kBins : (b >= kBins ? b - kBins : b)][k / 64] |= bit;
     }
   }
 
@@ -58,7 +59,8 @@ class LineDirectionBins {
     if (every_line_) return all_;
     const double angle = undirectedAngleDeg(direction);
     if (!std::isfinite(angle)) return all_;
-    return masks_[int(angle / kBinDeg) % kBins];
+    const int b = int(angle / kBinDeg);
+    return masks_[b >= kBins ? b - kBins : b];
   }
 
   // Undirected direction in [0, 180] deg; NaN for a vector whose squared norm is not finite in

@@ -148,7 +148,7 @@ int ProjectionMatcher::matchLines(const LineCandidate* candidates, int count, co
   }
   // Only the lines whose direction can pass the angle test are visited (line_direction_bins.h:
   // a superset of them, in index order, so the matches are those of testing every line).
-  LineDirectionBins bins;  // 3 kB, like the arrays above
+  LineDirectionBins bins;  // 1.5 kB on the stack, like the arrays above
   bins.build(obs_spans.data(), obs_lengths.data(), num_lines, 1e-3f, o.max_angle_deg);
   for (int c = 0; c < count; ++c) {
     const LineCandidate& cand = candidates[c];
