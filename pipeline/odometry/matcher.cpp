@@ -62,15 +62,27 @@ int ProjectionMatcher::matchPoints(const PointCandidate* candidates, int count, 
   std::fill_n(best_candidate_for_keypoint_.begin(), num_keypoints, -1);
   std::fill_n(best_distance_for_keypoint_.begin(), num_keypoints, 1 << 20);
 
+  // The keypoints' octaves in grid order, so the octave test, which rejects most keypoints of a
+  // window, reads them in sequence rather than through each keypoint's record.
+  const KeypointGrid& grid = frame.keypoint_grid;
+  const int slots = std::min<int>(grid.cell_start[KeypointGrid::kCols * KeypointGrid::kRows], kMaxKeypoints);
+  for (int s = 0; s < slots; ++s) grid_octave_[s] = frame.keypoints.data()[grid.indices[s]].octave;
+  // |octave - cand.octave| <= tolerance as one unsigned compare: octave - (cand.octave - t) in
+  // [0, 2t] (octaves are int8, so a tolerance above 255 admits all, a negative one none).
+  const int tolerance = std::min(o.octave_tolerance, 255);
   count = std::min(count, 65535);
   for (int c = 0; c < count; ++c) {
     const PointCandidate& cand = candidates[c];
+    if (tolerance < 0) continue;
     const float radius = o.search_radius_px * octaveScale(cand.octave);
     const float radius2 = radius * radius;
+    const int lowest_octave = cand.octave - tolerance;
+    const unsigned octave_span = static_cast<unsigned>(2 * tolerance);
     int best = 1 << 20, second = 1 << 20, best_kp = -1, best_octave = -1, second_octave = -1;
-    frame.keypoint_grid.forEachNear(cand.px_undist.x(), cand.px_undist.y(), radius, [&](int k) {
+    grid.forEachSlotNear(cand.px_undist.x(), cand.px_undist.y(), radius, [&](int slot) {
+      if (static_cast<unsigned>(grid_octave_[slot] - lowest_octave) > octave_span) return;
+      const int k = grid.indices[slot];
       const KeypointObservation& kp = frame.keypoints[k];
-      if (std::abs(kp.octave - cand.octave) > o.octave_tolerance) return;
       if ((kp.px_undist - cand.px_undist).squaredNorm() > radius2) return;
       const int d = hammingDistance(cand.descriptor, frame.keypoint_descriptors[k]);
       if (d < best) {

@@ -1,7 +1,10 @@
-// The line matcher's direction bins (pipeline/odometry/line_direction_bins.h) are a shortcut:
-// matchLines must return exactly what testing every line returns. The reference below is the
-// matcher's loop before the bins (every candidate against every line); random frames with lines
-// near the angle limit, across the 0/180 deg wrap, degenerate and non-finite ones, compare both.
+// Shortcuts in the projection matcher must not change a match:
+// - matchLines' direction bins (pipeline/odometry/line_direction_bins.h) must return exactly what
+//   testing every line returns. The reference below is the matcher's loop before the bins (every
+//   candidate against every line); random frames with lines near the angle limit, across the
+//   0/180 deg wrap, degenerate and non-finite ones, compare both.
+// - matchPoints' octave test on grid-ordered octaves must equal the |octave difference| test on
+//   each keypoint (the reference: the loop before it), for several tolerances.
 #include <cmath>
 #include <memory>
 #include <random>
@@ -10,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "pipeline/odometry/line_direction_bins.h"
+#include "pipeline/frontend/matcher_grid.h"
 #include "pipeline/odometry/matcher.h"
 
 namespace plumb {
@@ -206,6 +210,108 @@ TEST(LineMatcherBins, BinsHoldEveryLineThatPassesTheAngleTest) {
   }
   EXPECT_GT(passing, 0);
   EXPECT_LT(listed, passing * 2) << "the bins should hold few more lines than pass";
+}
+
+struct RefPointMatch {
+  int candidate, keypoint, distance;
+};
+
+// matchPoints before the grid-ordered octaves, without the orientation check.
+std::vector<RefPointMatch> referenceMatchPoints(const PointMatcherOptions& o, float scale_factor,
+                                                const PointCandidate* candidates, int count,
+                                                const FrameFeatures& frame) {
+  const int num_keypoints = static_cast<int>(frame.keypoints.size());
+  std::vector<int> best_candidate(num_keypoints, -1), best_distance(num_keypoints, 1 << 20);
+  for (int c = 0; c < count; ++c) {
+    const PointCandidate& cand = candidates[c];
+    const float radius = o.search_radius_px * std::pow(scale_factor, static_cast<float>(cand.octave));
+    const float radius2 = radius * radius;
+    int best = 1 << 20, second = 1 << 20, best_kp = -1, best_octave = -1, second_octave = -1;
+    frame.keypoint_grid.forEachNear(cand.px_undist.x(), cand.px_undist.y(), radius, [&](int k) {
+      const KeypointObservation& kp = frame.keypoints[k];
+      if (std::abs(kp.octave - cand.octave) > o.octave_tolerance) return;
+      if ((kp.px_undist - cand.px_undist).squaredNorm() > radius2) return;
+      const int d = hammingDistance(cand.descriptor, frame.keypoint_descriptors[k]);
+      if (d < best) {
+        second = best;
+        second_octave = best_octave;
+        best = d;
+        best_kp = k;
+        best_octave = kp.octave;
+      } else if (d < second) {
+        second = d;
+        second_octave = kp.octave;
+      }
+    });
+    if (best_kp < 0 || best > o.hamming_threshold) continue;
+    if (second_octave == best_octave && best > o.ratio * second) continue;
+    if (best < best_distance[best_kp]) {
+      best_distance[best_kp] = best;
+      best_candidate[best_kp] = c;
+    }
+  }
+  std::vector<RefPointMatch> out;
+  for (int k = 0; k < num_keypoints; ++k) {
+    if (best_candidate[k] >= 0) out.push_back({best_candidate[k], k, best_distance[k]});
+  }
+  return out;
+}
+
+TEST(PointMatcherOctaves, MatchesEqualTheOctaveDifferenceTest) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0.f, 640.f), v(0.f, 480.f), jitter(-12.f, 12.f);
+  std::uniform_int_distribution<int> octave(0, 7), bit(0, 255), flips(0, 30);
+  auto frame = std::make_unique<FrameFeatures>();
+  auto out = std::make_unique<PointMatches>();
+  std::vector<PointCandidate> candidates;
+  int total = 0;
+  for (int tolerance : {1, 0, 2, 300, -1}) {
+    SCOPED_TRACE(tolerance);
+    MatcherOptions options;
+    options.points.check_orientation = false;
+    options.points.octave_tolerance = tolerance;
+    ProjectionMatcher matcher(options);
+    for (int trial = 0; trial < 10; ++trial) {
+      frame->clear();
+      candidates.clear();
+      auto descriptor = [&](int n) {
+        Descriptor256 d;
+        d.words = {0x0123456789abcdefull, 0xfedcba9876543210ull, 0x0f0f0f0f0f0f0f0full, 0x5555aaaa5555aaaaull};
+        for (int i = 0; i < n; ++i) {
+          const int b = bit(rng);
+          d.words[b / 64] ^= uint64_t(1) << (b % 64);
+        }
+        return d;
+      };
+      const int num_keypoints = 300 + 60 * trial;
+      for (int k = 0; k < num_keypoints; ++k) {
+        KeypointObservation* kp = frame->keypoints.emplace_back();
+        kp->px_undist = Eigen::Vector2f(u(rng), v(rng));
+        kp->octave = static_cast<int8_t>(octave(rng));
+        (void)frame->keypoint_descriptors.push_back(descriptor(flips(rng)));
+      }
+      frame->keypoint_grid.setBounds(0, 0, 640, 480);
+      frame->keypoint_grid.build(num_keypoints, [&](int i) { return frame->keypoints[i].px_undist; });
+      for (int k = 0; k < num_keypoints; k += 2) {
+        PointCandidate c;
+        c.px_undist = frame->keypoints[k].px_undist + Eigen::Vector2f(jitter(rng), jitter(rng));
+        c.octave = static_cast<int8_t>(octave(rng));
+        c.descriptor = descriptor(flips(rng));
+        candidates.push_back(c);
+      }
+      const std::vector<RefPointMatch> expected = referenceMatchPoints(
+          options.points, options.scale_factor, candidates.data(), static_cast<int>(candidates.size()), *frame);
+      ASSERT_EQ(matcher.matchPoints(candidates.data(), static_cast<int>(candidates.size()), *frame, *out),
+                static_cast<int>(expected.size()));
+      for (std::size_t i = 0; i < expected.size(); ++i) {
+        EXPECT_EQ((*out)[i].candidate, expected[i].candidate);
+        EXPECT_EQ((*out)[i].keypoint, expected[i].keypoint);
+        EXPECT_EQ((*out)[i].distance, expected[i].distance);
+      }
+      total += static_cast<int>(expected.size());
+    }
+  }
+  EXPECT_GT(total, 500) << "the random frames must produce matches for the comparison to mean anything";
 }
 
 }  // namespace
