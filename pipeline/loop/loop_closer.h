@@ -257,6 +257,8 @@ class LoopCloser {
   double plausibilityChi2(int candidate_position, int query_position, const LoopMeasurement& m,
                           double* correction_m, double* correction_deg) const;
   void optimise();
+  // The odometry edges between keyframes of the record's local-map window, from its current poses.
+  void refreshWindowEdges(const LoopKeyframe& record);
   // After optimise() with the loop just accepted: the do-no-harm check; false = rolled back.
   bool confirmNewestLoop();
   // The loop edge's covariance is within max_loop_sigma_m / max_loop_sigma_rad.
