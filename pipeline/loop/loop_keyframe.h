@@ -13,7 +13,7 @@
 //           mapper's poses right after this keyframe's local BA, and the covariance of that relative
 //           pose from the BA's joint marginal, calibrated (the pose graph's odometry edge and its
 //           weight; docs/UNCERTAINTY.md).
-// Size: sizeof(LoopKeyframe), ~47 KB (computed in tests/pipeline/loop/loop_verifier_test.cpp). The closer
+// Size: sizeof(LoopKeyframe), ~52 KB (computed in tests/pipeline/loop/loop_verifier_test.cpp). The closer
 // keeps only a LoopCandidate of each record (below): what verification reads of a CANDIDATE.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
