@@ -6,7 +6,9 @@
 //   1. graph: a node for the keyframe, linked to the previous node by an odometry edge
 //      T_previous_this weighted by its calibrated covariance from local BA's joint marginal
 //      (docs/UNCERTAINTY.md; + a numerical floor only), or by a default
-//      information when BA gave none; a new map segment is linked by a weak edge.
+//      information when BA gave none; a new map segment is linked by a weak edge. Edges between
+//      keyframes still in the local map follow it: each record's window (the local map as its BA
+//      left it) refreshes them; keyframeFinal() replaces them when they leave it.
 //   2. detection: KeyframeDatabase query, candidates older than min_age_keyframes (outside the
 //      local window); a candidate must be consistent over min_consistent consecutive queries
 //      (each query had a candidate within consistency_neighbourhood ids of it).
