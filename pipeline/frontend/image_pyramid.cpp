@@ -126,15 +126,18 @@ PLUMB_BYTE_BLUR_INLINE void blurBytes(const uint8_t* const* rows, std::ptrdiff_t
   }
 }
 
-// Blurs [begin, end) from `rows` (offset by the column) into d: blocks of 16, the last one moved
-// back to end at `end` (recomputing a few outputs with the same values), or one or two blocks of
-// 8 when the range is 8..15 wide; returns the first column left for a scalar tail.
+// Blurs [begin, end) from `rows` (offset by the column) into d: blocks of 16, then a last block
+// of 8 or 16 moved back to end at `end` (recomputing a few outputs with the same values; 8 when
+// at most 8 columns are left: about half the work), or one or two blocks of 8 when the range is
+// 8..15 wide; returns the first column left for a scalar tail.
 PLUMB_BYTE_BLUR_INLINE int blurBlocks(const uint8_t* const* rows, int begin, int end, const ByteWeights& w, uint8_t* d) {
   if (end - begin >= 16) {
-    for (int x = begin; x < end;) {
-      const int bx = std::min(x, end - 16);
-      blurBytes<true>(rows, bx, w, d + bx);
-      x = bx + 16;
+    int x = begin;
+    for (; x + 16 <= end; x += 16) blurBytes<true>(rows, x, w, d + x);
+    if (x + 8 >= end) {
+      if (x < end) blurBytes<false>(rows, end - 8, w, d + end - 8);
+    } else {
+      blurBytes<true>(rows, end - 16, w, d + end - 16);
     }
     return end;
   }
@@ -175,31 +178,35 @@ PLUMB_BYTE_BLUR_INLINE void blurRowEvenOdd(const uint8_t* t, const AdjacentPairW
   _mm_storeu_si128(reinterpret_cast<__m128i*>(d), _mm_or_si128(even, _mm_slli_epi16(odd, 8)));
 }
 
-PLUMB_PYRAMID_SHUFFLE_TARGET void blurByteMultiplyAdd(const cv::Mat& src, cv::Mat& dst, int x0, int y0, int x1,
-                                                      int y1, const std::array<int, 7>& kernel, uint8_t* t) {
+PLUMB_PYRAMID_SHUFFLE_TARGET void blurByteMultiplyAdd(const cv::Mat& src, cv::Mat& dst, int y0, int y1,
+                                                      const ImagePyramid::Span* spans, int num_spans,
+                                                      const std::array<int, 7>& kernel, uint8_t* t) {
   // t: the byte row, valid on [-3, w + 3) after the edge mirroring below (t[w + 3], read by the
-  // last 16-wide horizontal block with weight 0, is padding).
+  // last 16-wide horizontal block with weight 0, is padding). The spans are inside the image.
   const int w = src.cols, h = src.rows;
   const ByteWeights weights(kernel);
   const AdjacentPairWeights adjacent(kernel);
-  const int vx0 = std::max(x0 - 3, 0), vx1 = std::min(x1 + 3, w);
   const uint8_t* columns[7];  // the horizontal pass: t shifted by -3 .. 3
   for (int i = 0; i < 7; ++i) columns[i] = t + i - 3;
   for (int y = y0; y < y1; ++y) {
     const uint8_t* r[7];
     for (int i = 0; i < 7; ++i) r[i] = src.ptr<uint8_t>(reflect101(y + i - 3, h));
-    blurVerticalScalar(r, kernel.data(), blurBlocks(r, vx0, vx1, weights, t), vx1, t);
-    mirrorEdges(t, w, x0, x1);
     uint8_t* d = dst.ptr<uint8_t>(y);
-    if (x1 - x0 >= 16) {  // blocks of 16, the last one moved back to end at x1
-      for (int x = x0; x < x1;) {
-        const int bx = std::min(x, x1 - 16);
-        blurRowEvenOdd(t + bx, adjacent, weights.round, d + bx);
-        x = bx + 16;
+    for (const ImagePyramid::Span* span = spans; span != spans + num_spans; ++span) {
+      const int x0 = span->x0, x1 = span->x1;
+      const int vx0 = std::max(x0 - 3, 0), vx1 = std::min(x1 + 3, w);
+      blurVerticalScalar(r, kernel.data(), blurBlocks(r, vx0, vx1, weights, t), vx1, t);
+      mirrorEdges(t, w, x0, x1);
+      if (x1 - x0 >= 16) {  // blocks of 16, the last one moved back to end at x1
+        for (int x = x0; x < x1;) {
+          const int bx = std::min(x, x1 - 16);
+          blurRowEvenOdd(t + bx, adjacent, weights.round, d + bx);
+          x = bx + 16;
+        }
+        continue;
       }
-      continue;
+      blurHorizontalScalar(t, kernel.data(), blurBlocks(columns, x0, x1, weights, d), x1, d);
     }
-    blurHorizontalScalar(t, kernel.data(), blurBlocks(columns, x0, x1, weights, d), x1, d);
   }
 }
 
@@ -274,7 +281,7 @@ ImagePyramid::ImagePyramid(int width, int height, int num_levels, float scale_fa
 void ImagePyramid::build(const cv::Mat& grey) {
   buildLevels(grey);
   // 7x7, sigma 2: the smoothing rotated BRIEF is defined on.
-  for (int i = 0; i < num_levels_; ++i) blur(levels_[i], blurred_levels_[i], 0, 0, levels_[i].cols, levels_[i].rows);
+  for (int i = 0; i < num_levels_; ++i) blurRect(i, 0, 0, levels_[i].cols, levels_[i].rows);
 }
 
 void ImagePyramid::buildLevels(const cv::Mat& grey) {
@@ -287,7 +294,21 @@ void ImagePyramid::buildLevels(const cv::Mat& grey) {
 }
 
 void ImagePyramid::blurRect(int level, int x0, int y0, int x1, int y1) {
-  blur(levels_[level], blurred_levels_[level], x0, y0, x1, y1);
+  const cv::Mat& src = levels_[level];
+  const Span span{std::max(x0, 0), std::min(x1, src.cols)};
+  y0 = std::max(y0, 0), y1 = std::min(y1, src.rows);
+  if (span.x0 >= span.x1 || y0 >= y1) return;
+  blur(src, blurred_levels_[level], y0, y1, &span, 1);
+}
+
+void ImagePyramid::blurRowSpans(int level, int y0, int y1, const Span* spans, int num_spans) {
+  const cv::Mat& src = levels_[level];
+  y0 = std::max(y0, 0), y1 = std::min(y1, src.rows);
+  if (y0 >= y1) return;
+  for (int i = 0; i < num_spans; ++i) {
+    CV_DbgAssert(spans[i].x0 >= 0 && spans[i].x0 < spans[i].x1 && spans[i].x1 <= src.cols);
+  }
+  blur(src, blurred_levels_[level], y0, y1, spans, num_spans);
 }
 
 #if PLUMB_PYRAMID_SHUFFLE
@@ -444,13 +465,10 @@ bool ImagePyramid::setBlurPath(BlurPath path) {
   return true;
 }
 
-void ImagePyramid::blur(const cv::Mat& src, cv::Mat& dst, int x0, int y0, int x1, int y1) {
+void ImagePyramid::blur(const cv::Mat& src, cv::Mat& dst, int y0, int y1, const Span* spans, int num_spans) {
 #if PLUMB_PYRAMID_SHUFFLE && defined(__x86_64__)
   if (blur_path_ == BlurPath::kByteMultiplyAdd) {
-    const int w = src.cols, h = src.rows;
-    x0 = std::max(x0, 0), y0 = std::max(y0, 0), x1 = std::min(x1, w), y1 = std::min(y1, h);
-    if (x0 >= x1 || y0 >= y1) return;
-    blurByteMultiplyAdd(src, dst, x0, y0, x1, y1, kernel_, row_filtered_bytes_.ptr<uint8_t>(0) + 3);
+    blurByteMultiplyAdd(src, dst, y0, y1, spans, num_spans, kernel_, row_filtered_bytes_.ptr<uint8_t>(0) + 3);
     return;
   }
 #endif
@@ -458,54 +476,55 @@ void ImagePyramid::blur(const cv::Mat& src, cv::Mat& dst, int x0, int y0, int x1
   // back to 8 bits of range so the horizontal pass also fits 16-bit lanes (the lost fraction is far
   // below what the binary tests can see). One padded 16-bit row buffer, reflected borders.
   const int w = src.cols, h = src.rows;
-  x0 = std::max(x0, 0), y0 = std::max(y0, 0), x1 = std::min(x1, w), y1 = std::min(y1, h);
-  if (x0 >= x1 || y0 >= y1) return;
-  // The vertical pass covers the columns the horizontal one reads, [x0 - 3, x1 + 3) inside the
-  // image; the 3 columns past an image edge are mirrored from inside it afterwards.
-  const int vx0 = std::max(x0 - 3, 0), vx1 = std::min(x1 + 3, w);
   uint16_t* t = row_filtered_.ptr<uint16_t>(0) + 3;  // t[-3 .. w+2] valid after padding
   const uint16_t k[7] = {uint16_t(kernel_[0]), uint16_t(kernel_[1]), uint16_t(kernel_[2]), uint16_t(kernel_[3]),
                          uint16_t(kernel_[4]), uint16_t(kernel_[5]), uint16_t(kernel_[6])};
   cv::v_uint16x8 vk[7];
   for (int i = 0; i < 7; ++i) vk[i] = cv::v_setall_u16(k[i]);
   const cv::v_uint16x8 half = cv::v_setall_u16(128);
-  // Rows of whole vector blocks; a partial last block is moved back to end at the range's end
-  // and recomputes a few columns with the same values (so a small rectangle needs no scalar tail).
-  const int v_block_end = vx1 - vx0 >= 16 ? vx1 : vx0;
-  const int h_block_end = x1 - x0 >= 8 ? x1 : x0;
   for (int y = y0; y < y1; ++y) {
     const uint8_t* r[7];
     for (int i = 0; i < 7; ++i) r[i] = src.ptr<uint8_t>(reflect101(y + i - 3, h));
-    // The kernel is symmetric: rows 3 - i and 3 + i are added first (<= 510) and multiplied
-    // once, 4 multiplies instead of 7 for the same integer sum (<= 65280: no overflow).
-    for (int x = vx0; x < v_block_end;) {
-      const int bx = std::min(x, v_block_end - 16);
-      x = bx + 16;
-      cv::v_uint16x8 lo, hi, a, b;
-      cv::v_expand(cv::v_load(r[3] + bx), lo, hi);
-      lo = cv::v_mul_wrap(lo, vk[3]);
-      hi = cv::v_mul_wrap(hi, vk[3]);
-      for (int i = 0; i < 3; ++i) {
-        cv::v_uint16x8 c, e;
-        cv::v_expand(cv::v_load(r[i] + bx), a, b);
-        cv::v_expand(cv::v_load(r[6 - i] + bx), c, e);
-        lo += cv::v_mul_wrap(a + c, vk[i]);
-        hi += cv::v_mul_wrap(b + e, vk[i]);
-      }
-      cv::v_store(t + bx, (lo + half) >> 8);
-      cv::v_store(t + bx + 8, (hi + half) >> 8);
-    }
-    blurVerticalScalar(r, kernel_.data(), v_block_end > vx0 ? vx1 : vx0, vx1, t);
-    mirrorEdges(t, w, x0, x1);
     uint8_t* d = dst.ptr<uint8_t>(y);
-    for (int x = x0; x < h_block_end;) {
-      const int bx = std::min(x, h_block_end - 8);
-      x = bx + 8;
-      cv::v_uint16x8 acc = cv::v_mul_wrap(cv::v_load(t + bx), vk[3]);
-      for (int i = 0; i < 3; ++i) acc += cv::v_mul_wrap(cv::v_load(t + bx + i - 3) + cv::v_load(t + bx + 3 - i), vk[i]);
-      cv::v_pack_store(d + bx, (acc + half) >> 8);
+    for (const Span* span = spans; span != spans + num_spans; ++span) {
+      const int x0 = span->x0, x1 = span->x1;
+      // The vertical pass covers the columns the horizontal one reads, [x0 - 3, x1 + 3) inside the
+      // image; the 3 columns past an image edge are mirrored from inside it afterwards.
+      const int vx0 = std::max(x0 - 3, 0), vx1 = std::min(x1 + 3, w);
+      // Whole vector blocks; a partial last block is moved back to end at the range's end and
+      // recomputes a few columns with the same values (so a small span needs no scalar tail).
+      const int v_block_end = vx1 - vx0 >= 16 ? vx1 : vx0;
+      const int h_block_end = x1 - x0 >= 8 ? x1 : x0;
+      // The kernel is symmetric: rows 3 - i and 3 + i are added first (<= 510) and multiplied
+      // once, 4 multiplies instead of 7 for the same integer sum (<= 65280: no overflow).
+      for (int x = vx0; x < v_block_end;) {
+        const int bx = std::min(x, v_block_end - 16);
+        x = bx + 16;
+        cv::v_uint16x8 lo, hi, a, b;
+        cv::v_expand(cv::v_load(r[3] + bx), lo, hi);
+        lo = cv::v_mul_wrap(lo, vk[3]);
+        hi = cv::v_mul_wrap(hi, vk[3]);
+        for (int i = 0; i < 3; ++i) {
+          cv::v_uint16x8 c, e;
+          cv::v_expand(cv::v_load(r[i] + bx), a, b);
+          cv::v_expand(cv::v_load(r[6 - i] + bx), c, e);
+          lo += cv::v_mul_wrap(a + c, vk[i]);
+          hi += cv::v_mul_wrap(b + e, vk[i]);
+        }
+        cv::v_store(t + bx, (lo + half) >> 8);
+        cv::v_store(t + bx + 8, (hi + half) >> 8);
+      }
+      blurVerticalScalar(r, kernel_.data(), v_block_end > vx0 ? vx1 : vx0, vx1, t);
+      mirrorEdges(t, w, x0, x1);
+      for (int x = x0; x < h_block_end;) {
+        const int bx = std::min(x, h_block_end - 8);
+        x = bx + 8;
+        cv::v_uint16x8 acc = cv::v_mul_wrap(cv::v_load(t + bx), vk[3]);
+        for (int i = 0; i < 3; ++i) acc += cv::v_mul_wrap(cv::v_load(t + bx + i - 3) + cv::v_load(t + bx + 3 - i), vk[i]);
+        cv::v_pack_store(d + bx, (acc + half) >> 8);
+      }
+      blurHorizontalScalar(t, kernel_.data(), h_block_end > x0 ? x1 : x0, x1, d);
     }
-    blurHorizontalScalar(t, kernel_.data(), h_block_end > x0 ? x1 : x0, x1, d);
   }
 }
 

@@ -25,12 +25,19 @@ class ImagePyramid {
   // grey: CV_8UC1 of the level-0 size. Fills every level and the blurred levels. `grey` may be
   // levelZero() itself (written by the caller in place: no copy).
   void build(const cv::Mat& grey);
-  // Fills the levels only; blurRect() then blurs just the parts a caller reads (ORB blurs the
-  // neighbourhoods of the keypoints it describes: ~half of the pixels on fr1/rpy). A blurred
-  // pixel has the same value either way; pixels never blurred keep older contents.
+  // Fills the levels only; blurRect() or blurRowSpans() then blurs just the parts a caller reads
+  // (ORB blurs the columns its keypoints' tests read). A blurred pixel has the same value either
+  // way; pixels never blurred keep older contents.
   void buildLevels(const cv::Mat& grey);
   // Blurs [x0, x1) x [y0, y1) of `level` (clipped to the level) into blurred(level).
   void blurRect(int level, int x0, int y0, int x1, int y1);
+  // Blurs the columns [x0, x1) of each span on rows [y0, y1) of `level` (clipped to the level)
+  // into blurred(level). The spans must lie inside the level and be non-empty; they may overlap
+  // (the same values are written twice). One call shares each row's set-up among its spans.
+  struct Span {
+    int x0, x1;
+  };
+  void blurRowSpans(int level, int y0, int y1, const Span* spans, int num_spans);
 
   int numLevels() const { return num_levels_; }
   float scale(int level) const { return scales_[level]; }  // scale_factor^level
@@ -53,9 +60,10 @@ class ImagePyramid {
  private:
   int num_levels_;
   std::array<float, kPyramidLevels> scales_{};
-  // The separable 7-tap blur of src on [x0, x1) x [y0, y1) into dst, borders reflected at the
-  // image edges (not at the rectangle's): every pixel gets the value a whole-image pass gives.
-  void blur(const cv::Mat& src, cv::Mat& dst, int x0, int y0, int x1, int y1);
+  // The separable 7-tap blur of src on the spans of rows [y0, y1) into dst (spans inside the
+  // image, non-empty), borders reflected at the image edges (not at a span's): every pixel gets
+  // the value a whole-image pass gives.
+  void blur(const cv::Mat& src, cv::Mat& dst, int y0, int y1, const Span* spans, int num_spans);
   void downsample(int level);  // levels_[level - 1] -> levels_[level], bilinear
 
   // Bilinear sampling table of one axis of one level: source index and the 11-bit fixed-point

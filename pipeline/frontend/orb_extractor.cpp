@@ -23,7 +23,15 @@ OrbExtractor::OrbExtractor(const PinholeCamera& camera, const ExtractorOptions& 
   rank_start_.resize(kMaxCornersPerLevel + 1);
   cell_has_corner_.resize(static_cast<size_t>(camera.width / 8 + 1) * (camera.height / 8 + 1));
   cell_start_.resize(cell_has_corner_.size() + 1);
-  blur_tile_needed_.resize(static_cast<size_t>(camera.width / kBlurTile + 1) * (camera.height / kBlurTile + 1));
+  // One bit per column and a spare word per band of rows (see blurAroundKeypoints), and a
+  // band's spans.
+  CV_Assert(describer_.sampleReach() < OrbDescriber::kBorder);
+  buildBandMasks();
+  blur_band_words_ = (camera.width + 63) / 64 + 1;
+  // + bands_per_keypoint_: a keypoint's last bands may be past the level's last one (ORed with 0).
+  blur_band_bits_.resize(static_cast<size_t>(blur_band_words_) *
+                         ((camera.height + kBlurBand - 1) / kBlurBand + bands_per_keypoint_));
+  blur_spans_.resize(camera.width / 2 + 1);
   // Geometric share per level: n0 * (1/s)^i, summing to num_features (ORB-SLAM's split).
   const int levels = pyramid_.numLevels();
   const double inv = 1.0 / options.scale_factor;
@@ -127,14 +135,15 @@ void OrbExtractor::selectOnLevel(int level, int wanted, FrameFeatures& out) {
     first = end;
   }
 
-  blurAroundKeypoints(level, take);
-
+  // Orientation from the level image first, then the blur of just the rows and columns the
+  // descriptors of these keypoints read (their orientation bins known), then rotated BRIEF.
   const float scale = pyramid_.scale(level);
   const uint8_t* level_origin = image.ptr<uint8_t>(0);
-  const uint8_t* blurred_origin = pyramid_.blurred(level).ptr<uint8_t>(0);
   const int stride = pyramid_.stride();
-  for (int i = 0; i < take; ++i) {
-    const FastCorner& c = by_rank_[i].corner;
+  const int first = static_cast<int>(out.keypoints.size());
+  int kept = 0;
+  for (; kept < take; ++kept) {
+    const FastCorner& c = by_rank_[kept].corner;
     KeypointObservation* kp = out.keypoints.emplace_back();
     Descriptor256* descriptor = out.keypoint_descriptors.emplace_back();
     if (kp == nullptr || descriptor == nullptr) {  // capacity reached: keep the arrays parallel
@@ -142,53 +151,97 @@ void OrbExtractor::selectOnLevel(int level, int wanted, FrameFeatures& out) {
       if (descriptor != nullptr) out.keypoint_descriptors.pop_back();
       break;
     }
-    if (i + 1 < take) {
-      // The patches of consecutive keypoints are far apart (ranked order) and the levels were
+    if (kept + 1 < take) {
+      // The patches of consecutive keypoints are far apart (ranked order) and the level was
       // written long ago: fetch the next keypoint's rows while this one is computed.
-      const FastCorner& next = by_rank_[i + 1].corner;
-      const int next_offset = next.y * stride + next.x;
+      const FastCorner& next = by_rank_[kept + 1].corner;
+      const uint8_t* next_patch = level_origin + next.y * stride + next.x;
       for (int dy = -OrbDescriber::kPatchRadius; dy <= OrbDescriber::kPatchRadius; ++dy) {
-        __builtin_prefetch(level_origin + next_offset + dy * stride - OrbDescriber::kPatchRadius);
-        __builtin_prefetch(level_origin + next_offset + dy * stride + OrbDescriber::kPatchRadius);
-        __builtin_prefetch(blurred_origin + next_offset + dy * stride - OrbDescriber::kPatchRadius);
-        __builtin_prefetch(blurred_origin + next_offset + dy * stride + OrbDescriber::kPatchRadius);
+        __builtin_prefetch(next_patch + dy * stride - OrbDescriber::kPatchRadius);
+        __builtin_prefetch(next_patch + dy * stride + OrbDescriber::kPatchRadius);
       }
     }
-    const int offset = c.y * stride + c.x;
-    kp->angle_deg = describer_.orientationDeg(level_origin + offset);
-    describer_.describe(blurred_origin + offset, kp->angle_deg, *descriptor);
+    kp->angle_deg = describer_.orientationDeg(level_origin + c.y * stride + c.x);
     kp->px = Eigen::Vector2f(c.x * scale, c.y * scale);
     kp->px_undist = camera_.undistortPoint(kp->px.x(), kp->px.y()).cast<float>();
     kp->response = c.score;
     kp->octave = static_cast<int8_t>(level);
   }
+
+  blurAroundKeypoints(level, out.keypoints.data() + first, kept);
+
+  const uint8_t* blurred_origin = pyramid_.blurred(level).ptr<uint8_t>(0);
+  for (int i = 0; i < kept; ++i) {
+    const FastCorner& c = by_rank_[i].corner;
+    describer_.describe(blurred_origin + c.y * stride + c.x, out.keypoints[first + i].angle_deg,
+                        out.keypoint_descriptors[first + i]);
+  }
 }
 
-void OrbExtractor::blurAroundKeypoints(int level, int take) {
-  // Marks the tiles holding a sample of some keypoint's BRIEF tests, then blurs each row of tiles
-  // in runs of consecutive marked tiles. The tiles are small enough that a 32 px cell's keypoint
-  // does not drag in much more than its own neighbourhood.
+void OrbExtractor::blurAroundKeypoints(int level, const KeypointObservation* keypoints, int count) {
+  // Bands of kBlurBand rows, one bit per column: the columns each keypoint's tests read on the
+  // band's rows (OrbDescriber::sampleRowMask of its orientation bin, ORed over the rows of the
+  // band; see buildBandMasks), placed at x - reach: bits of two words. Then each band is blurred
+  // on the runs of set bits, a run widened to kMinBlurSpan (one vector block in both passes) and
+  // runs less than kBlurSpanGap apart joined, since a separate run costs its own vertical margin
+  // and set-up.
   const cv::Mat& image = pyramid_.level(level);
-  const int tile_cols = (image.cols + kBlurTile - 1) / kBlurTile, tile_rows = (image.rows + kBlurTile - 1) / kBlurTile;
-  char* needed = blur_tile_needed_.data();
-  std::fill_n(needed, static_cast<size_t>(tile_cols) * tile_rows, 0);
-  const int reach = describer_.sampleReach();
-  for (int i = 0; i < take; ++i) {
+  const int words = blur_band_words_;
+  const int num_bands = (image.rows + kBlurBand - 1) / kBlurBand;
+  uint64_t* bits = blur_band_bits_.data();
+  std::fill_n(bits, static_cast<size_t>(num_bands) * words, 0);
+  const int reach = describer_.sampleReach();  // < kBorder: every mask lies inside the level
+  for (int i = 0; i < count; ++i) {
     const FastCorner& c = by_rank_[i].corner;
-    const int tx0 = std::max(c.x - reach, 0) / kBlurTile, tx1 = std::min(c.x + reach, image.cols - 1) / kBlurTile;
-    const int ty0 = std::max(c.y - reach, 0) / kBlurTile, ty1 = std::min(c.y + reach, image.rows - 1) / kBlurTile;
-    for (int ty = ty0; ty <= ty1; ++ty) std::fill(needed + ty * tile_cols + tx0, needed + ty * tile_cols + tx1 + 1, 1);
+    const int top = c.y - reach, base = c.x - reach, shift = base & 63;
+    const uint64_t* masks = bandMasks(OrbDescriber::angleBin(keypoints[i].angle_deg), top % kBlurBand);
+    uint64_t* band = bits + static_cast<size_t>(top / kBlurBand) * words + (base >> 6);
+    for (int j = 0; j < bands_per_keypoint_; ++j, band += words) {
+      band[0] |= masks[j] << shift;
+      band[1] |= (masks[j] >> 1) >> (63 - shift);  // the bits shifted past word 0 (none when shift is 0)
+    }
   }
-  for (int ty = 0; ty < tile_rows; ++ty) {
-    const char* row = needed + ty * tile_cols;
-    for (int tx = 0; tx < tile_cols;) {
-      if (!row[tx]) {
-        ++tx;
-        continue;
+  ImagePyramid::Span* spans = blur_spans_.data();
+  for (int b = 0; b < num_bands; ++b) {
+    // Runs from the edges of the bit row (bits that differ from the one before); the spare last
+    // word is never set, so every run ends inside the row.
+    const uint64_t* row = bits + static_cast<size_t>(b) * words;
+    int num_spans = 0, run_start = -1;
+    uint64_t previous_top_bit = 0;
+    for (int w = 0; w < words; ++w) {
+      const uint64_t word = row[w];
+      uint64_t edges = word ^ ((word << 1) | previous_top_bit);
+      previous_top_bit = word >> 63;
+      for (; edges != 0; edges &= edges - 1) {
+        const int x = w * 64 + __builtin_ctzll(edges);
+        if (run_start < 0) {
+          run_start = x;
+          continue;
+        }
+        ImagePyramid::Span span{run_start, std::min(std::max(x, run_start + kMinBlurSpan), image.cols)};
+        span.x0 = std::max(0, std::min(span.x0, span.x1 - kMinBlurSpan));
+        run_start = -1;
+        if (num_spans > 0 && span.x0 <= spans[num_spans - 1].x1 + kBlurSpanGap) {
+          spans[num_spans - 1].x1 = std::max(spans[num_spans - 1].x1, span.x1);
+        } else {
+          spans[num_spans++] = span;
+        }
       }
-      const int run_start = tx;
-      while (tx < tile_cols && row[tx]) ++tx;
-      pyramid_.blurRect(level, run_start * kBlurTile, ty * kBlurTile, tx * kBlurTile, (ty + 1) * kBlurTile);
+    }
+    if (num_spans > 0) pyramid_.blurRowSpans(level, b * kBlurBand, std::min((b + 1) * kBlurBand, image.rows), spans, num_spans);
+  }
+}
+
+void OrbExtractor::buildBandMasks() {
+  // Keypoint rows top .. top + 2 * reach; with phase = top % kBlurBand, row offset o falls in
+  // band (phase + o) / kBlurBand of the keypoint's bands.
+  const int reach = describer_.sampleReach();
+  bands_per_keypoint_ = (kBlurBand - 1 + 2 * reach) / kBlurBand + 1;
+  band_masks_.assign(static_cast<size_t>(OrbDescriber::kAngleBins) * kBlurBand * bands_per_keypoint_, 0);
+  for (int bin = 0; bin < OrbDescriber::kAngleBins; ++bin) {
+    for (int phase = 0; phase < kBlurBand; ++phase) {
+      uint64_t* masks = band_masks_.data() + (static_cast<size_t>(bin) * kBlurBand + phase) * bands_per_keypoint_;
+      for (int o = 0; o <= 2 * reach; ++o) masks[(phase + o) / kBlurBand] |= describer_.sampleRowMask(bin, o - reach);
     }
   }
 }

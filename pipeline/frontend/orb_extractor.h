@@ -6,8 +6,9 @@
 // (every cell's best corner first, then every cell's second best, ...), each round strongest
 // first. FAST runs on the whole level at the high threshold, and again at the low threshold in
 // the cells that found nothing, so weak-texture regions still get keypoints (ORB-SLAM's
-// adaptive threshold). Then orientation by intensity centroid,
-// rotated BRIEF on the blurred level, and undistortion of the keypoint coordinate.
+// adaptive threshold). Then orientation by intensity centroid, the blur of just the pixels the
+// chosen keypoints' tests read (their orientation bins known), rotated BRIEF on the blurred
+// level, and undistortion of the keypoint coordinate.
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -43,9 +44,18 @@ class OrbExtractor {
   };
 
   void selectOnLevel(int level, int wanted, FrameFeatures& out);
-  // Blurs the parts of `level` the descriptors of its first `take` ranked corners read.
-  void blurAroundKeypoints(int level, int take);
-  static constexpr int kBlurTile = 8;  // px, square: 8 blurs ~7 % fewer pixels than 16 on fr1/rpy
+  // Blurs the parts of `level` the descriptors of its first `count` ranked corners read, given
+  // their orientations (keypoints[i] is ranked corner i).
+  void blurAroundKeypoints(int level, const KeypointObservation* keypoints, int count);
+  static constexpr int kBlurBand = 8;      // rows blurred on the same runs of columns
+  static constexpr int kMinBlurSpan = 16;  // px: one vector block of the blur
+  static constexpr int kBlurSpanGap = 16;  // px: runs closer than this are blurred as one
+  // Per orientation bin and phase (the keypoint's top sample row modulo kBlurBand), the columns
+  // its tests read in each of the bands_per_keypoint_ bands it touches: bit dx + reach.
+  void buildBandMasks();
+  const uint64_t* bandMasks(int bin, int phase) const {
+    return band_masks_.data() + (static_cast<size_t>(bin) * kBlurBand + phase) * bands_per_keypoint_;
+  }
 
   PinholeCamera camera_;
   ExtractorOptions options_;
@@ -62,7 +72,13 @@ class OrbExtractor {
   std::vector<int> cell_start_;
   std::vector<int, ZeroPageAllocator<int>> rank_start_;
   std::vector<char> cell_has_corner_;  // per spreading cell of the current level (sized for 8 px cells)
-  std::vector<char> blur_tile_needed_;  // per kBlurTile tile of the current level
+  // The columns blurAroundKeypoints blurs in each band of kBlurBand rows of the current level,
+  // one bit each, blur_band_words_ words a band; and one band's runs of them.
+  int blur_band_words_ = 0;
+  std::vector<uint64_t> blur_band_bits_;
+  std::vector<ImagePyramid::Span> blur_spans_;
+  std::vector<uint64_t> band_masks_;  // see bandMasks()
+  int bands_per_keypoint_ = 0;
   double pyramid_ms_ = 0;
 };
 

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -155,18 +157,29 @@ TEST(FrontendKernels, BlurPathsEqualTheFixedPointReference) {
   if (!have_bytes) GTEST_SKIP() << "no SSSE3 (or not x86-64): only the portable blur was checked";
 }
 
-class BlurOfRectangles : public ::testing::TestWithParam<ImagePyramid::BlurPath> {};
+class BlurOfRectangles : public ::testing::TestWithParam<ImagePyramid::BlurPath> {
+ protected:
+  // whole_: a 643x481 test image's pyramid blurred everywhere; parts_: its levels only, on the
+  // blur path under test. False when this CPU or build does not have the path.
+  bool makePyramids(uint64_t seed) {
+    const cv::Mat img = testImage(643, 481, seed);
+    whole_ = std::make_unique<ImagePyramid>(img.cols, img.rows, 8, 1.2f);
+    whole_->build(img);
+    parts_ = std::make_unique<ImagePyramid>(img.cols, img.rows, 8, 1.2f);
+    if (!parts_->setBlurPath(GetParam())) return false;
+    parts_->buildLevels(img);
+    return true;
+  }
+  std::unique_ptr<ImagePyramid> whole_, parts_;
+};
 
 TEST_P(BlurOfRectangles, EqualTheWholeImageBlurInsideThem) {
   // ORB blurs only around its keypoints (ImagePyramid::blurRect): small, odd-sized rectangles
   // at the image edges and inside must get exactly the whole-image values, and nothing outside
   // them may be written.
-  const cv::Mat img = testImage(643, 481, 13);
-  ImagePyramid whole(img.cols, img.rows, 8, 1.2f);
-  whole.build(img);
-  ImagePyramid parts(img.cols, img.rows, 8, 1.2f);
-  if (!parts.setBlurPath(GetParam())) GTEST_SKIP() << "this blur path does not exist on this CPU";
-  parts.buildLevels(img);
+  if (!makePyramids(13)) GTEST_SKIP() << "this blur path does not exist on this CPU";
+  const ImagePyramid& whole = *whole_;
+  ImagePyramid& parts = *parts_;
   const cv::Rect rects[] = {{0, 0, 5, 3}, {0, 0, 16, 16}, {1, 2, 7, 9}, {30, 40, 17, 33}, {100, 7, 64, 16},
                             {200, 200, 3, 40}, {600, 450, 43, 31}, {630, 10, 13, 20}, {2, 470, 30, 11}};
   for (int level = 0; level < 8; ++level) {
@@ -186,36 +199,138 @@ TEST_P(BlurOfRectangles, EqualTheWholeImageBlurInsideThem) {
   }
 }
 
+TEST_P(BlurOfRectangles, RowSpansEqualTheWholeImageBlurInsideThem) {
+  // blurRowSpans (ORB's per-band blur): bands of 1 to 9 rows, each with up to 6 random spans of
+  // 1 to 70 columns, overlapping or not, at the edges and inside, on every level.
+  if (!makePyramids(17)) GTEST_SKIP() << "this blur path does not exist on this CPU";
+  const ImagePyramid& whole = *whole_;
+  ImagePyramid& parts = *parts_;
+  cv::RNG rng(5);
+  int spans_checked = 0;
+  for (int level = 0; level < 8; ++level) {
+    const cv::Mat before = parts.blurred(level).clone();
+    const int w = before.cols, h = before.rows;
+    cv::Mat written(before.size(), CV_8UC1, cv::Scalar(0));
+    for (int band = 0; band < 40; ++band) {
+      const int y0 = band == 0 ? 0 : (band == 1 ? h - 3 : rng.uniform(0, h));
+      const int y1 = std::min(h, y0 + rng.uniform(1, 10));
+      ImagePyramid::Span spans[6];
+      const int num_spans = rng.uniform(1, 7);
+      for (int i = 0; i < num_spans; ++i) {
+        const int width = std::min(w, rng.uniform(1, 71));
+        const int x0 = i == 0 && band % 3 == 0 ? 0 : (i == 1 && band % 3 == 1 ? w - width : rng.uniform(0, w - width + 1));
+        spans[i] = {x0, x0 + width};
+        written(cv::Rect(x0, y0, width, y1 - y0)).setTo(1);
+      }
+      parts.blurRowSpans(level, y0, y1, spans, num_spans);
+      for (int i = 0; i < num_spans; ++i) {
+        const cv::Rect r(spans[i].x0, y0, spans[i].x1 - spans[i].x0, y1 - y0);
+        ASSERT_EQ(cv::norm(parts.blurred(level)(r), whole.blurred(level)(r), cv::NORM_INF), 0)
+            << "level " << level << " span " << r;
+        ++spans_checked;
+      }
+    }
+    const cv::Mat untouched = written == 0;
+    EXPECT_EQ(cv::norm(parts.blurred(level), before, cv::NORM_INF, untouched), 0) << "level " << level;
+  }
+  EXPECT_GT(spans_checked, 500);
+}
+
 INSTANTIATE_TEST_SUITE_P(FrontendKernels, BlurOfRectangles,
                          ::testing::Values(ImagePyramid::BlurPath::kPortable, ImagePyramid::BlurPath::kByteMultiplyAdd),
                          [](const ::testing::TestParamInfo<ImagePyramid::BlurPath>& info) {
                            return info.param == ImagePyramid::BlurPath::kPortable ? "Portable" : "ByteMultiplyAdd";
                          });
 
+// Images for the orientation test: smoothed texture, raw uniform noise, and 0/255 halves split
+// left-right and top-bottom (the largest |m10| and |m01| the disc can have, where a 16-bit
+// partial sum would wrap first), plus a 0/255 checkerboard of 1 px.
+std::vector<cv::Mat> orientationTestImages() {
+  std::vector<cv::Mat> images{testImage(200, 150, 12)};
+  cv::Mat noise(120, 161, CV_8UC1);
+  cv::RNG(7).fill(noise, cv::RNG::UNIFORM, 0, 256);
+  images.push_back(noise);
+  for (int split = 0; split < 3; ++split) {
+    cv::Mat img(90, 97, CV_8UC1);
+    for (int y = 0; y < img.rows; ++y)
+      for (int x = 0; x < img.cols; ++x) {
+        const bool bright = split == 0 ? x >= img.cols / 2 : split == 1 ? y >= img.rows / 2 : (x + y) % 2 == 0;
+        img.at<uint8_t>(y, x) = bright ? 255 : 0;
+      }
+    images.push_back(img);
+    images.push_back(255 - img);
+  }
+  return images;
+}
+
 TEST(FrontendKernels, OrientationEqualsIntensityCentroidOverTheDisc) {
-  const cv::Mat img = testImage(200, 150, 12);
-  const OrbDescriber describer(static_cast<int>(img.step[0]));
   const int r = OrbDescriber::kPatchRadius;
-  int compared = 0;
-  std::array<int, 4> quadrants{};
-  for (int y = OrbDescriber::kBorder; y < img.rows - OrbDescriber::kBorder; y += 3) {
-    for (int x = OrbDescriber::kBorder; x < img.cols - OrbDescriber::kBorder; x += 5) {
-      int m10 = 0, m01 = 0;
-      for (int dy = -r; dy <= r; ++dy) {
-        const int w = static_cast<int>(std::floor(std::sqrt(double(r * r - dy * dy)) + 0.5));
-        for (int dx = -w; dx <= w; ++dx) {
-          m10 += dx * img.at<uint8_t>(y + dy, x + dx);
-          m01 += dy * img.at<uint8_t>(y + dy, x + dx);
+  // Every path this CPU and build have (the x86 one needs x86-64 with SSSE3; elsewhere the
+  // portable path alone is checked).
+  std::vector<OrbDescriber::KernelPath> paths{OrbDescriber::KernelPath::kPortable};
+  if (OrbDescriber(64).setKernelPath(OrbDescriber::KernelPath::kX86)) paths.push_back(OrbDescriber::KernelPath::kX86);
+  for (const auto path : paths) {
+    SCOPED_TRACE(path == OrbDescriber::KernelPath::kPortable ? "portable" : "x86");
+    int compared = 0, image_index = 0;
+    std::array<int, 4> quadrants{};
+    for (const cv::Mat& img : orientationTestImages()) {
+      SCOPED_TRACE("image " + std::to_string(image_index++));
+      OrbDescriber describer(static_cast<int>(img.step[0]));
+      ASSERT_TRUE(describer.setKernelPath(path));
+      for (int y = OrbDescriber::kBorder; y < img.rows - OrbDescriber::kBorder; y += 3) {
+        for (int x = OrbDescriber::kBorder; x < img.cols - OrbDescriber::kBorder; x += 5) {
+          int m10 = 0, m01 = 0;
+          for (int dy = -r; dy <= r; ++dy) {
+            const int w = static_cast<int>(std::floor(std::sqrt(double(r * r - dy * dy)) + 0.5));
+            for (int dx = -w; dx <= w; ++dx) {
+              m10 += dx * img.at<uint8_t>(y + dy, x + dx);
+              m01 += dy * img.at<uint8_t>(y + dy, x + dx);
+            }
+          }
+          const float expected = cv::fastAtan2(static_cast<float>(m01), static_cast<float>(m10));
+          ASSERT_EQ(describer.orientationDeg(img.ptr<uint8_t>(y) + x), expected) << "at " << x << "," << y;
+          ++quadrants[std::min(3, static_cast<int>(expected / 90))];
+          ++compared;
         }
       }
-      const float expected = cv::fastAtan2(static_cast<float>(m01), static_cast<float>(m10));
-      ASSERT_EQ(describer.orientationDeg(img.ptr<uint8_t>(y) + x), expected) << "at " << x << "," << y;
-      ++quadrants[std::min(3, static_cast<int>(expected / 90))];
-      ++compared;
+    }
+    EXPECT_GT(compared, 1500);
+    for (int q : quadrants) EXPECT_GT(q, 10);  // every direction occurs
+  }
+}
+
+// The x86 path's bit packing (cmp + adc) against the portable compares, every orientation bin,
+// on raw noise (many equal pairs: the strict < matters) and the smoothed test image; and the
+// bins really differ (the angle picks the pattern).
+TEST(FrontendKernels, DescriptorPathsGiveTheSameBits) {
+  std::vector<cv::Mat> images = orientationTestImages();
+  cv::Mat coarse_noise(70, 83, CV_8UC1);
+  cv::RNG(3).fill(coarse_noise, cv::RNG::UNIFORM, 0, 4);  // values 0..3: many ties
+  images.push_back(coarse_noise);
+  int compared = 0, differing_bins = 0;
+  for (const cv::Mat& img : images) {
+    OrbDescriber portable(static_cast<int>(img.step[0])), x86(static_cast<int>(img.step[0]));
+    ASSERT_TRUE(portable.setKernelPath(OrbDescriber::KernelPath::kPortable));
+    if (!x86.setKernelPath(OrbDescriber::KernelPath::kX86)) GTEST_SKIP() << "no SSSE3 (or not x86-64)";
+    for (int y = OrbDescriber::kBorder; y < img.rows - OrbDescriber::kBorder; y += 7) {
+      for (int x = OrbDescriber::kBorder; x < img.cols - OrbDescriber::kBorder; x += 11) {
+        Descriptor256 previous;
+        for (int bin = 0; bin < OrbDescriber::kAngleBins; ++bin) {
+          const float angle = bin * 360.0f / OrbDescriber::kAngleBins;
+          ASSERT_EQ(OrbDescriber::angleBin(angle), bin);
+          Descriptor256 a, b;
+          portable.describe(img.ptr<uint8_t>(y) + x, angle, a);
+          x86.describe(img.ptr<uint8_t>(y) + x, angle, b);
+          ASSERT_EQ(a.words, b.words) << "at " << x << "," << y << ", bin " << bin;
+          if (bin > 0 && a.words != previous.words) ++differing_bins;
+          previous = a;
+          ++compared;
+        }
+      }
     }
   }
-  EXPECT_GT(compared, 500);
-  for (int q : quadrants) EXPECT_GT(q, 10);  // every direction occurs
+  EXPECT_GT(compared, 3000);
+  EXPECT_GT(differing_bins, compared / 2);
 }
 
 // The descriptor's definition, one sample at a time with plain if/else accumulation.

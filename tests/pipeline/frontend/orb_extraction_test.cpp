@@ -8,6 +8,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/frontend/feature_extractor.h"
+#include "pipeline/frontend/image_pyramid.h"
+#include "pipeline/frontend/orb_descriptor.h"
+#include "pipeline/frontend/orb_extractor.h"
 #include "pipeline/frontend/orb_fast.h"
 #include "tests/pipeline/frontend_test_support.h"
 
@@ -220,6 +223,44 @@ TEST(OrbExtraction, SameInputGivesIdenticalOutput) {
       ASSERT_EQ(fa->lines[i].num_samples, other->lines[i].num_samples);
     }
   }
+}
+
+TEST(OrbExtraction, DescriptorsEqualThoseOnTheWholeBlurredPyramid) {
+  // OrbExtractor blurs only the columns each keypoint's tests read (bands of rows, from its
+  // orientation bin): describing every keypoint again on a pyramid blurred everywhere must give
+  // the same bits. Frames in sequence through one extractor, so that a sample left unblurred
+  // would read an older frame's value (or the initial zeros) and differ.
+  auto scene = test::makeScene("textured", 6);
+  ASSERT_TRUE(scene);
+  OrbExtractor extractor(scene->camera(), ExtractorOptions());
+  int compared = 0;
+  std::vector<int> per_level(kPyramidLevels, 0);
+  for (int frame_index : {0, 7, 14}) {
+    const RgbdImage frame = test::renderFrame(*scene, frame_index);
+    cv::Mat grey;
+    cv::cvtColor(frame.bgr, grey, cv::COLOR_BGR2GRAY);
+    auto features = std::make_unique<FrameFeatures>();
+    extractor.extract(grey, *features);
+    ASSERT_GT(features->keypoints.size(), 500u);
+    const ImagePyramid& partial = extractor.pyramid();
+    ImagePyramid whole(grey.cols, grey.rows, partial.numLevels(), ExtractorOptions().scale_factor);
+    whole.build(grey);
+    const OrbDescriber describer(whole.stride());
+    for (size_t i = 0; i < features->keypoints.size(); ++i) {
+      const KeypointObservation& kp = features->keypoints[i];
+      const float scale = whole.scale(kp.octave);
+      const int x = static_cast<int>(std::lround(kp.px.x() / scale)), y = static_cast<int>(std::lround(kp.px.y() / scale));
+      ASSERT_EQ(kp.px.x(), x * scale);
+      Descriptor256 expected;
+      describer.describe(whole.blurred(kp.octave).ptr<uint8_t>(y) + x, kp.angle_deg, expected);
+      ASSERT_EQ(features->keypoint_descriptors[i].words, expected.words)
+          << "frame " << frame_index << ", keypoint " << i << " at " << x << "," << y << " level " << int(kp.octave);
+      ++per_level[kp.octave];
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 1500);
+  for (int level = 0; level < ExtractorOptions().num_levels; ++level) EXPECT_GT(per_level[level], 0) << "level " << level;
 }
 
 TEST(OrbExtraction, OrientationAndDescriptorFollowAnImageRotation) {
