@@ -2,6 +2,7 @@
 // FixedVector<T, N>: a vector whose storage is inline and whose capacity is a compile-time
 // constant. push_back never allocates; it returns false when full (the caller decides whether
 // that is a drop to count or a bug). Used for every per-frame container on the hot path.
+#include <algorithm>
 #include <array>
 #include <cassert>
 #include <cstddef>
@@ -23,6 +24,13 @@ class FixedVector {
     if (size_ == N) return nullptr;
     data_[size_] = T{};
     return &data_[size_++];
+  }
+  // *this = other, copying only other's elements, not all N as the copy assignment does (for
+  // containers of large T copied per frame); the entries past size() keep what they held.
+  void assignUsed(const FixedVector& other) {
+    if (this == &other) return;
+    std::copy(other.begin(), other.end(), data_.begin());
+    size_ = other.size_;
   }
   void pop_back() { assert(size_ > 0); --size_; }
   void clear() { size_ = 0; }

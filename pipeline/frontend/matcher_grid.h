@@ -64,11 +64,17 @@ struct KeypointGrid {
   // centred at (u, v) with half-size `radius` (callers check the exact distance).
   template <typename Fn>
   void forEachNear(float u, float v, float radius, Fn fn) const {
+    forEachSlotNear(u, v, radius, [&](int slot) { fn(indices[slot]); });
+  }
+  // The same visiting order, calling fn(slot) with the position in `indices` (for callers that
+  // keep per-keypoint data in grid order).
+  template <typename Fn>
+  void forEachSlotNear(float u, float v, float radius, Fn fn) const {
     const int c0 = cellCol(u - radius), c1 = cellCol(u + radius);
     const int r0 = cellRow(v - radius), r1 = cellRow(v + radius);
     for (int r = r0; r <= r1; ++r) {
       const int row = r * kCols;
-      for (int i = cell_start[row + c0]; i < cell_start[row + c1 + 1]; ++i) fn(indices[i]);
+      for (int i = cell_start[row + c0]; i < cell_start[row + c1 + 1]; ++i) fn(i);
     }
   }
 };

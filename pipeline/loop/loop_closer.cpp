@@ -169,6 +169,28 @@ void LoopCloser::addNode(const LoopKeyframe& r, int slot) {
   order_.push_back(slot);
 }
 
+void LoopCloser::refreshWindowEdges(const LoopKeyframe& r) {
+  // An odometry edge between two keyframes still in the local map is their relative pose as the
+  // BA that inserted the later one left it; every local BA since refined both poses. The record
+  // carries the local map as the newest BA left it: those edges become the relative of the two
+  // current poses (a relative pose: the same whatever loop corrections moved the map rigidly).
+  // Their covariances stay (the BA that made the edge). Edges of keyframes that left the local
+  // map are the final poses' (keyframeFinal) and are not touched.
+  for (const LoopWindowPose& w : r.window) {
+    const int p = findPosition(w.id);
+    if (p <= 0) continue;
+    Node& n = nodes_[std::size_t(order_[std::size_t(p)])];
+    if (!n.has_edge || n.has_final || n.previous_map_id == 0) continue;
+    if (nodes_[std::size_t(order_[std::size_t(p - 1)])].id != n.previous_map_id) continue;
+    for (const LoopWindowPose& previous : r.window) {
+      if (previous.id != n.previous_map_id) continue;
+      n.T_previous_this = previous.T_world_cam.inverse() * w.T_world_cam;
+      n.edge_length_m = n.T_previous_this.translation().norm();
+      break;
+    }
+  }
+}
+
 bool LoopCloser::addKeyframe(const LoopKeyframe& record) {
   ++stats_.keyframes;
   if (!order_.empty() && record.id <= nodes_[std::size_t(order_.back())].id) return false;  // out of order
@@ -178,6 +200,7 @@ bool LoopCloser::addKeyframe(const LoopKeyframe& record) {
   makeLoopCandidate(record, &records_[std::size_t(slot)]);
   const LoopKeyframe& r = record;
   addNode(r, slot);
+  refreshWindowEdges(r);
   const int query_position = int(order_.size()) - 1;
   audit_.addKeyframe(r.id, r.timestamp_s);
 

@@ -6,7 +6,9 @@
 //   1. graph: a node for the keyframe, linked to the previous node by an odometry edge
 //      T_previous_this weighted by its calibrated covariance from local BA's joint marginal
 //      (docs/UNCERTAINTY.md; + a numerical floor only), or by a default
-//      information when BA gave none; a new map segment is linked by a weak edge.
+//      information when BA gave none; a new map segment is linked by a weak edge. Edges between
+//      keyframes still in the local map follow it: each record's window (the local map as its BA
+//      left it) refreshes them; keyframeFinal() replaces them when they leave it.
 //   2. detection: KeyframeDatabase query, candidates older than min_age_keyframes (outside the
 //      local window); a candidate must be consistent over min_consistent consecutive queries
 //      (each query had a candidate within consistency_neighbourhood ids of it).
@@ -257,6 +259,8 @@ class LoopCloser {
   double plausibilityChi2(int candidate_position, int query_position, const LoopMeasurement& m,
                           double* correction_m, double* correction_deg) const;
   void optimise();
+  // The odometry edges between keyframes of the record's local-map window, from its current poses.
+  void refreshWindowEdges(const LoopKeyframe& record);
   // After optimise() with the loop just accepted: the do-no-harm check; false = rolled back.
   bool confirmNewestLoop();
   // The loop edge's covariance is within max_loop_sigma_m / max_loop_sigma_rad.

@@ -80,9 +80,11 @@ bool makeLoopKeyframe(const KeyframeRequest& request, uint32_t keyframe_id, bool
   out->previous_id = 0;
   out->T_previous_this = Eigen::Isometry3d::Identity();
   int previous_slot = -1;
+  out->window.clear();
   for (int s = 0; s < int(kMaxMapKeyframes); ++s) {
     if (!map.keyframeAlive(s)) continue;
     const uint32_t id = map.keyframe(s).id;
+    (void)out->window.push_back(LoopWindowPose{id, map.keyframe(s).T_world_cam});
     if (id < keyframe_id && (previous_slot < 0 || id > map.keyframe(previous_slot).id)) previous_slot = s;
   }
   if (!new_segment && previous_slot >= 0) {

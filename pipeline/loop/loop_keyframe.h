@@ -13,7 +13,7 @@
 //           mapper's poses right after this keyframe's local BA, and the covariance of that relative
 //           pose from the BA's joint marginal, calibrated (the pose graph's odometry edge and its
 //           weight; docs/UNCERTAINTY.md).
-// Size: sizeof(LoopKeyframe), ~47 KB (computed in tests/pipeline/loop/loop_verifier_test.cpp). The closer
+// Size: sizeof(LoopKeyframe), ~52 KB (computed in tests/pipeline/loop/loop_verifier_test.cpp). The closer
 // keeps only a LoopCandidate of each record (below): what verification reads of a CANDIDATE.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -22,6 +22,7 @@
 
 #include "pipeline/frontend/frame_features.h"
 #include "pipeline/odometry/keyframe_request.h"
+#include "pipeline/odometry/map_capacities.h"
 #include "platform/fixed_vector.h"
 #include "solver/types.h"
 
@@ -48,6 +49,12 @@ struct LoopLine {
   std::array<Eigen::Vector3f, kMaxLineSamples> samples_cam{};
 };
 
+// A keyframe of the local map as local BA has it when the record is made (mapping frame).
+struct LoopWindowPose {
+  uint32_t id = 0;
+  Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
+};
+
 struct LoopKeyframe {
   uint32_t id = 0;  // the map's keyframe id (grows forever)
   uint64_t frame_sequence = 0;
@@ -63,6 +70,10 @@ struct LoopKeyframe {
   // left on T_cam_world) when no BA held both keyframes.
   Matrix6d covariance = Matrix6d::Zero();
   bool covariance_valid = false;
+  // Every keyframe of the local map (this one included), as the BA that just ran left them: the
+  // closer refreshes its odometry edges between keyframes still in the local map with these
+  // (docs/LOOP.md "`--out` with loops: what is left"). Unordered.
+  FixedVector<LoopWindowPose, kMaxMapKeyframes> window;
 
   FixedVector<LoopPoint, kMaxLoopPoints> points;
   FixedVector<Descriptor256, kMaxLoopPoints> point_descriptors;  // parallel to points

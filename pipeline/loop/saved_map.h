@@ -44,7 +44,7 @@ struct SavedLoopEdge {
 
 struct SavedMap {
   PinholeCamera camera;
-  // Ascending ids. Each SavedKeyframe is ~47 KB (a LoopKeyframe), so they are held by pointer: a
+  // Ascending ids. Each SavedKeyframe is ~52 KB (a LoopKeyframe), so they are held by pointer: a
   // vector of them never copies records when it grows.
   std::vector<std::unique_ptr<SavedKeyframe>> keyframes;
   std::vector<SavedLoopEdge> loop_edges;

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "pipeline/odometry/line_direction_bins.h"
+
 namespace plumb {
 namespace {
 
@@ -60,15 +62,27 @@ int ProjectionMatcher::matchPoints(const PointCandidate* candidates, int count, 
   std::fill_n(best_candidate_for_keypoint_.begin(), num_keypoints, -1);
   std::fill_n(best_distance_for_keypoint_.begin(), num_keypoints, 1 << 20);
 
+  // The keypoints' octaves in grid order, so the octave test, which rejects most keypoints of a
+  // window, reads them in sequence rather than through each keypoint's record.
+  const KeypointGrid& grid = frame.keypoint_grid;
+  const int slots = std::min<int>(grid.cell_start[KeypointGrid::kCols * KeypointGrid::kRows], kMaxKeypoints);
+  for (int s = 0; s < slots; ++s) grid_octave_[s] = frame.keypoints.data()[grid.indices[s]].octave;
+  // |octave - cand.octave| <= tolerance as one unsigned compare: octave - (cand.octave - t) in
+  // [0, 2t] (octaves are int8, so a tolerance above 255 admits all, a negative one none).
+  const int tolerance = std::min(o.octave_tolerance, 255);
   count = std::min(count, 65535);
   for (int c = 0; c < count; ++c) {
     const PointCandidate& cand = candidates[c];
+    if (tolerance < 0) continue;
     const float radius = o.search_radius_px * octaveScale(cand.octave);
     const float radius2 = radius * radius;
+    const int lowest_octave = cand.octave - tolerance;
+    const unsigned octave_span = static_cast<unsigned>(2 * tolerance);
     int best = 1 << 20, second = 1 << 20, best_kp = -1, best_octave = -1, second_octave = -1;
-    frame.keypoint_grid.forEachNear(cand.px_undist.x(), cand.px_undist.y(), radius, [&](int k) {
+    grid.forEachSlotNear(cand.px_undist.x(), cand.px_undist.y(), radius, [&](int slot) {
+      if (static_cast<unsigned>(grid_octave_[slot] - lowest_octave) > octave_span) return;
+      const int k = grid.indices[slot];
       const KeypointObservation& kp = frame.keypoints[k];
-      if (std::abs(kp.octave - cand.octave) > o.octave_tolerance) return;
       if ((kp.px_undist - cand.px_undist).squaredNorm() > radius2) return;
       const int d = hammingDistance(cand.descriptor, frame.keypoint_descriptors[k]);
       if (d < best) {
@@ -136,13 +150,18 @@ int ProjectionMatcher::matchLines(const LineCandidate* candidates, int count, co
   // Per observed line, once instead of once per candidate (the same float operations, so the
   // same values): its span, its length, and the angle test's bound.
   std::array<Eigen::Vector2f, kMaxLines> obs_spans;
-  std::array<float, kMaxLines> obs_lengths, angle_bounds;
+  obs_spans.fill(Eigen::Vector2f::Zero());  // read only below num_lines; GCC cannot tell
+  std::array<float, kMaxLines> obs_lengths{}, angle_bounds;
   for (int k = 0; k < num_lines; ++k) {
     const LineObservation& obs = frame.lines[k];
     obs_spans[k] = obs.end_px - obs.start_px;
     obs_lengths[k] = obs_spans[k].norm();
     angle_bounds[k] = cos_max_angle * obs_lengths[k];
   }
+  // Only the lines whose direction can pass the angle test are visited (line_direction_bins.h:
+  // a superset of them, in index order, so the matches are those of testing every line).
+  LineDirectionBins bins;  // 1.5 kB on the stack, like the arrays above
+  bins.build(obs_spans.data(), obs_lengths.data(), num_lines, 1e-3f, o.max_angle_deg);
   for (int c = 0; c < count; ++c) {
     const LineCandidate& cand = candidates[c];
     const Eigen::Vector2f span = cand.end_px - cand.start_px;
@@ -151,16 +170,16 @@ int ProjectionMatcher::matchLines(const LineCandidate* candidates, int count, co
     const Eigen::Vector2f u = span / length;
     const Eigen::Vector2f n(-u.y(), u.x());
     int best = 1 << 20, second = 1 << 20, best_line = -1;
-    for (int k = 0; k < num_lines; ++k) {
+    forEachLine(bins.near(span), [&](int k) {
       const float obs_length = obs_lengths[k];
-      if (obs_length < 1e-3f) continue;
-      if (std::abs(u.dot(obs_spans[k])) < angle_bounds[k]) continue;  // undirected angle
+      if (obs_length < 1e-3f) return;
+      if (std::abs(u.dot(obs_spans[k])) < angle_bounds[k]) return;  // undirected angle
       const LineObservation& obs = frame.lines[k];
       const Eigen::Vector2f ds = obs.start_px - cand.start_px, de = obs.end_px - cand.start_px;
-      if (std::abs(n.dot(ds)) > o.max_endpoint_distance_px || std::abs(n.dot(de)) > o.max_endpoint_distance_px) continue;
+      if (std::abs(n.dot(ds)) > o.max_endpoint_distance_px || std::abs(n.dot(de)) > o.max_endpoint_distance_px) return;
       const float t0 = std::min(u.dot(ds), u.dot(de)), t1 = std::max(u.dot(ds), u.dot(de));
       const float overlap = std::min(t1, length) - std::max(t0, 0.f);
-      if (overlap < o.min_overlap * std::min(length, obs_length)) continue;
+      if (overlap < o.min_overlap * std::min(length, obs_length)) return;
       const int d = hammingDistance(cand.descriptor, frame.line_descriptors[k]);
       if (d < best) {
         second = best;
@@ -169,7 +188,7 @@ int ProjectionMatcher::matchLines(const LineCandidate* candidates, int count, co
       } else if (d < second) {
         second = d;
       }
-    }
+    });
     if (best_line < 0 || best > o.lbd_threshold || best > o.ratio * second) continue;
     if (best < best_distance[best_line]) {
       best_distance[best_line] = best;

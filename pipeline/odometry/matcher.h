@@ -124,6 +124,7 @@ class ProjectionMatcher {
   FixedVector<uint16_t, kMaxLines> line_candidate_source_;
   std::array<int, kMaxKeypoints> best_candidate_for_keypoint_{};
   std::array<int, kMaxKeypoints> best_distance_for_keypoint_{};
+  std::array<int8_t, kMaxKeypoints> grid_octave_{};  // matchPoints: keypoint octaves in grid order
 };
 
 }  // namespace plumb

@@ -214,7 +214,7 @@ bool Tracker::keyframeNeeded(const FrameFeatures& frame, const TrackResult& resu
 }
 
 void Tracker::rememberLastFrame(const FrameFeatures& frame, const Eigen::Isometry3d& T_world_cam) {
-  b_->last_frame = frame;
+  b_->last_frame.copyFrom(frame);
   T_world_last_ = T_world_cam;
   has_last_frame_ = true;
   last_reference_id_ = local_map_->reference_keyframe_id;
