@@ -2,7 +2,7 @@
 // sensor noise (docs/UNCERTAINTY.md). One line per seed, then the pooled table row per quantity.
 //
 //   plumb_nees_study [--preset textured] [--seeds 50] [--first-seed 1] [--frames 150] [--no-lines]
-//                    [--map-error] [--no-variance-factor] [--pooled-variance-factor]
+//                    [--map-error | --no-map-error] [--no-variance-factor] [--pooled-variance-factor]
 //                    [--relative-scale S] [--tracked-scale S]
 #include <cstdio>
 #include <cstdlib>
@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
     else if (a == "--frames" && has_value) frames = std::atoi(argv[++i]);
     else if (a == "--no-lines") system_options.odometry.tracker.use_lines = false;
     else if (a == "--map-error") system_options.odometry.uncertainty.tracked_map_error = true;
+    else if (a == "--no-map-error") system_options.odometry.uncertainty.tracked_map_error = false;
     else if (a == "--no-variance-factor") system_options.odometry.uncertainty.use_variance_factor = false;
     else if (a == "--pooled-variance-factor") system_options.odometry.uncertainty.variance_components = false;
     else if (a == "--relative-scale" && has_value) system_options.odometry.uncertainty.relative_scale = std::atof(argv[++i]);
