@@ -70,10 +70,9 @@ int ProjectionMatcher::matchPoints(const PointCandidate* candidates, int count, 
   // |octave - cand.octave| <= tolerance as one unsigned compare: octave - (cand.octave - t) in
   // [0, 2t] (octaves are int8, so a tolerance above 255 admits all, a negative one none).
   const int tolerance = std::min(o.octave_tolerance, 255);
-  count = std::min(count, 65535);
+  count = tolerance < 0 ? 0 : std::min(count, 65535);  // a negative tolerance admits no keypoint
   for (int c = 0; c < count; ++c) {
     const PointCandidate& cand = candidates[c];
-    if (tolerance < 0) continue;
     const float radius = o.search_radius_px * octaveScale(cand.octave);
     const float radius2 = radius * radius;
     const int lowest_octave = cand.octave - tolerance;
