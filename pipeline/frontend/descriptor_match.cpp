@@ -2,6 +2,8 @@
 
 #include <cstdint>
 
+#include "pipeline/frontend/descriptor_match_avx2.h"
+
 // x86-64 without -mpopcnt (the portable baseline): the scans are built twice, the portable copy on
 // hammingDistance's SSE2 bit-slicing and a POPCNT copy picked at run time (every x86-64 CPU since
 // ~2008 has it). Elsewhere (aarch64, -mpopcnt builds) __builtin_popcountll is inline already and
@@ -54,14 +56,40 @@ bool cpuHasPopcnt() {
 }
 #endif
 
+#if PLUMB_SCAN_AVX2
+bool cpuHasAvx2() {
+  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("popcnt");
+  return has;
+}
+#endif
+
 }  // namespace
 
-bool descriptorScanUsesPopcnt() {
+bool descriptorScanAvailable(DescriptorScanPath path) {
+  switch (path) {
+    case DescriptorScanPath::kPortable:
+      return true;
+    case DescriptorScanPath::kPopcnt:
 #if PLUMB_SCAN_DISPATCH
-  return cpuHasPopcnt();
+      return cpuHasPopcnt();
 #else
-  return false;
+      return false;
 #endif
+    case DescriptorScanPath::kAvx2:
+#if PLUMB_SCAN_AVX2
+      return cpuHasAvx2();
+#else
+      return false;
+#endif
+  }
+  return false;
+}
+
+DescriptorScanPath descriptorScanPath() {
+  static const DescriptorScanPath path = descriptorScanAvailable(DescriptorScanPath::kAvx2)     ? DescriptorScanPath::kAvx2
+                                         : descriptorScanAvailable(DescriptorScanPath::kPopcnt) ? DescriptorScanPath::kPopcnt
+                                                                                                : DescriptorScanPath::kPortable;
+  return path;
 }
 
 int ratioBound(int max_distance, float ratio, int none) {
@@ -71,28 +99,55 @@ int ratioBound(int max_distance, float ratio, int none) {
   return none;
 }
 
-NearestTwo nearestTwoBelow(const Descriptor256& d, const Descriptor256* others, std::size_t n, int bound) {
+NearestTwo nearestTwoBelowOn(DescriptorScanPath path, const Descriptor256& d, const Descriptor256* others,
+                             std::size_t n, int bound) {
+  switch (path) {
+    case DescriptorScanPath::kPortable:
+      break;
+    case DescriptorScanPath::kPopcnt:
 #if PLUMB_SCAN_DISPATCH
-  if (cpuHasPopcnt()) return popcnt::nearestTwoBelowKernel(d, others, n, bound);
+      return popcnt::nearestTwoBelowKernel(d, others, n, bound);
+#else
+      break;
 #endif
+    case DescriptorScanPath::kAvx2:
+#if PLUMB_SCAN_AVX2
+      return descriptor_scan_avx2::nearestTwoBelow(d, others, n, bound);
+#else
+      break;
+#endif
+  }
   return portable::nearestTwoBelowKernel(d, others, n, bound);
+}
+
+void nearestBothWaysOn(DescriptorScanPath path, const Descriptor256* a, std::size_t na, const Descriptor256* b,
+                       std::size_t nb, int row_bound, int col_bound, NearestTwo* rows, int* col_best, int* col_index) {
+  switch (path) {
+    case DescriptorScanPath::kPortable:
+      break;
+    case DescriptorScanPath::kPopcnt:
+#if PLUMB_SCAN_DISPATCH
+      return popcnt::nearestBothWaysKernel(a, na, b, nb, row_bound, col_bound, rows, col_best, col_index);
+#else
+      break;
+#endif
+    case DescriptorScanPath::kAvx2:
+#if PLUMB_SCAN_AVX2
+      return descriptor_scan_avx2::nearestBothWays(a, na, b, nb, row_bound, col_bound, rows, col_best, col_index);
+#else
+      break;
+#endif
+  }
+  portable::nearestBothWaysKernel(a, na, b, nb, row_bound, col_bound, rows, col_best, col_index);
+}
+
+NearestTwo nearestTwoBelow(const Descriptor256& d, const Descriptor256* others, std::size_t n, int bound) {
+  return nearestTwoBelowOn(descriptorScanPath(), d, others, n, bound);
 }
 
 void nearestBothWays(const Descriptor256* a, std::size_t na, const Descriptor256* b, std::size_t nb, int row_bound,
                      int col_bound, NearestTwo* rows, int* col_best, int* col_index) {
-#if PLUMB_SCAN_DISPATCH
-  if (cpuHasPopcnt()) return popcnt::nearestBothWaysKernel(a, na, b, nb, row_bound, col_bound, rows, col_best, col_index);
-#endif
-  portable::nearestBothWaysKernel(a, na, b, nb, row_bound, col_bound, rows, col_best, col_index);
-}
-
-NearestTwo nearestTwoBelowPortable(const Descriptor256& d, const Descriptor256* others, std::size_t n, int bound) {
-  return portable::nearestTwoBelowKernel(d, others, n, bound);
-}
-
-void nearestBothWaysPortable(const Descriptor256* a, std::size_t na, const Descriptor256* b, std::size_t nb,
-                             int row_bound, int col_bound, NearestTwo* rows, int* col_best, int* col_index) {
-  portable::nearestBothWaysKernel(a, na, b, nb, row_bound, col_bound, rows, col_best, col_index);
+  nearestBothWaysOn(descriptorScanPath(), a, na, b, nb, row_bound, col_bound, rows, col_best, col_index);
 }
 
 }  // namespace plumb

@@ -8,10 +8,11 @@
 // rules most lookalikes out.
 //
 // The scans are brute force (every pair) and are the loop stage's main cost, so they live in
-// descriptor_match.cpp with two builds of the same loops: x86-64's portable baseline has no
-// POPCNT (hammingDistance is ~30 SSE2 instructions there), so on CPUs that have it (chosen at run
-// time) a copy compiled for POPCNT counts each 64-bit word in one instruction. Both count the
-// same bits: the results are the same integers. docs/LOOP.md "Cost".
+// descriptor_match.cpp with more than one build: x86-64's portable baseline has no POPCNT
+// (hammingDistance is ~30 SSE2 instructions there), so on CPUs that have it (chosen at run time) a
+// copy compiled for POPCNT counts each 64-bit word in one instruction, and one for AVX2 counts four
+// descriptors at a time. All count the same bits and update in index order: the same results.
+// docs/LOOP.md "Cost of the loop stage".
 #include <cstddef>
 
 #include "pipeline/frontend/frame_features.h"
@@ -67,11 +68,16 @@ inline int bestRatioMatch(const Descriptor256& d, const Descriptor256* others, s
 void nearestBothWays(const Descriptor256* a, std::size_t na, const Descriptor256* b, std::size_t nb, int row_bound,
                      int col_bound, NearestTwo* rows, int* col_best, int* col_index);
 
-// The same scans, always on the portable path (hammingDistance), for tests to compare the two.
-NearestTwo nearestTwoBelowPortable(const Descriptor256& d, const Descriptor256* others, std::size_t n, int bound);
-void nearestBothWaysPortable(const Descriptor256* a, std::size_t na, const Descriptor256* b, std::size_t nb,
-                             int row_bound, int col_bound, NearestTwo* rows, int* col_best, int* col_index);
-// True when the scans above run the POPCNT copy on this CPU.
-bool descriptorScanUsesPopcnt();
+// The builds of the scans: kPortable runs everywhere; on x86-64 without -mpopcnt, kPopcnt (POPCNT
+// word counts) and kAvx2 (four descriptors at a time, descriptor_match_avx2.cpp) where the CPU has
+// them. The scans above use the fastest available one (descriptorScanPath()); the *On variants
+// run a given one, for tests to compare them (an unavailable one runs kPortable).
+enum class DescriptorScanPath { kPortable, kPopcnt, kAvx2 };
+bool descriptorScanAvailable(DescriptorScanPath path);
+DescriptorScanPath descriptorScanPath();
+NearestTwo nearestTwoBelowOn(DescriptorScanPath path, const Descriptor256& d, const Descriptor256* others,
+                             std::size_t n, int bound);
+void nearestBothWaysOn(DescriptorScanPath path, const Descriptor256* a, std::size_t na, const Descriptor256* b,
+                       std::size_t nb, int row_bound, int col_bound, NearestTwo* rows, int* col_best, int* col_index);
 
 }  // namespace plumb

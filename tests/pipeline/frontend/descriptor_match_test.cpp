@@ -25,13 +25,18 @@ int bitDistance(const Descriptor256& a, const Descriptor256& b) {
   return n;
 }
 
-// The two nearest of others below `bound` by sorting (distance, index): the definition, not a scan.
-NearestTwo sortedNearestTwo(const Descriptor256& d, const std::vector<Descriptor256>& others, int bound) {
+// The distances of d to every one of others, bit by bit.
+std::vector<int> bitDistances(const Descriptor256& d, const std::vector<Descriptor256>& others) {
+  std::vector<int> out;
+  for (const Descriptor256& o : others) out.push_back(bitDistance(d, o));
+  return out;
+}
+
+// The two nearest below `bound` by sorting (distance, index): the definition, not a scan.
+NearestTwo sortedNearestTwo(const std::vector<int>& distances, int bound) {
   std::vector<std::pair<int, int>> by_distance;
-  for (std::size_t j = 0; j < others.size(); ++j) {
-    const int dist = bitDistance(d, others[j]);
-    if (dist < bound) by_distance.emplace_back(dist, int(j));
-  }
+  for (std::size_t j = 0; j < distances.size(); ++j)
+    if (distances[j] < bound) by_distance.emplace_back(distances[j], int(j));
   std::sort(by_distance.begin(), by_distance.end());
   NearestTwo r;
   r.best = r.second = bound;
@@ -105,8 +110,17 @@ class DescriptorSets {
 
 const std::size_t kSizes[] = {0, 1, 2, 3, 4, 5, 7, 8, 15, 16, 17, 33, 64, 127, 500};
 
+// Every build of the scans this CPU can run (kPortable always; kPopcnt and kAvx2 on x86-64).
+std::vector<DescriptorScanPath> availablePaths() {
+  std::vector<DescriptorScanPath> out;
+  for (DescriptorScanPath p : {DescriptorScanPath::kPortable, DescriptorScanPath::kPopcnt, DescriptorScanPath::kAvx2})
+    if (descriptorScanAvailable(p)) out.push_back(p);
+  return out;
+}
+
 TEST(DescriptorMatch, NearestTwoBelowEqualsSortedDefinitionOnEveryPathAndBound) {
-  std::printf("descriptor scans use POPCNT: %s\n", descriptorScanUsesPopcnt() ? "yes" : "no");
+  std::printf("descriptor scan builds on this CPU: %zu, in use: %d\n", availablePaths().size(),
+              int(descriptorScanPath()));
   DescriptorSets sets(7);
   int trial = 0, ties = 0;
   for (std::size_t n : kSizes) {
@@ -116,10 +130,12 @@ TEST(DescriptorMatch, NearestTwoBelowEqualsSortedDefinitionOnEveryPathAndBound) 
       const int max_flips = rep % 3 == 0 ? 2 : 40;  // many exact ties, or spread distances
       const std::vector<Descriptor256> others = sets.set(n, bases, max_flips);
       const Descriptor256 d = rep % 5 == 0 ? sets.random() : sets.near(bases[0], max_flips);
+      const std::vector<int> distances = bitDistances(d, others);
       for (int bound : {0, 1, 5, 20, 51, 63, 76, 100, 128, 200, 256, 257}) {
-        const NearestTwo expected = sortedNearestTwo(d, others, bound);
+        const NearestTwo expected = sortedNearestTwo(distances, bound);
         expectSame(nearestTwoBelow(d, others.data(), n, bound), expected, "dispatched", trial);
-        expectSame(nearestTwoBelowPortable(d, others.data(), n, bound), expected, "portable", trial);
+        for (DescriptorScanPath path : availablePaths())
+          expectSame(nearestTwoBelowOn(path, d, others.data(), n, bound), expected, "path", trial);
         ties += expected.second_index >= 0 && expected.best == expected.second;
       }
       // bound 256 is the unbounded scan: nearestTwo() as it always was.
@@ -184,11 +200,13 @@ TEST(DescriptorMatch, BoundedScanDecidesEveryMatchAsTheFullScan) {
           const NearestTwo full = plainNearestTwo(d, others, 256);
           const int bound = ratioBound(threshold, ratio);
           const NearestTwo bounded = nearestTwoBelow(d, others.data(), n, bound);
-          const NearestTwo portable = nearestTwoBelowPortable(d, others.data(), n, bound);
           for (bool pairs : {false, true}) {
             const auto expected = verifierDecision(full, threshold, ratio, pairs);
             ASSERT_EQ(verifierDecision(bounded, threshold, ratio, pairs), expected) << "trial " << trial;
-            ASSERT_EQ(verifierDecision(portable, threshold, ratio, pairs), expected) << "trial " << trial;
+            for (DescriptorScanPath path : availablePaths()) {
+              const NearestTwo on_path = nearestTwoBelowOn(path, d, others.data(), n, bound);
+              ASSERT_EQ(verifierDecision(on_path, threshold, ratio, pairs), expected) << "trial " << trial;
+            }
             matched += expected.first >= 0;
             ambiguous += expected.second >= 0;
             rejected += expected.first < 0;
@@ -217,26 +235,28 @@ TEST(DescriptorMatch, NearestBothWaysEqualsRowAndColumnDefinitions) {
         for (int b = 0; b < 1 + rep; ++b) bases.push_back(sets.random());
         const int max_flips = rep == 0 ? 3 : 30;
         const std::vector<Descriptor256> a = sets.set(na, bases, max_flips), b = sets.set(nb, bases, max_flips);
+        std::vector<std::vector<int>> row_distances;  // [k][l]
+        for (const Descriptor256& d : a) row_distances.push_back(bitDistances(d, b));
         for (auto [row_bound, col_bound] : {std::pair{257, 257}, std::pair{63, 51}, std::pair{76, 61},
                                             std::pair{20, 40}, std::pair{0, 0}, std::pair{5, 3}}) {
-          for (int path = 0; path < 2; ++path) {
+          for (DescriptorScanPath path : availablePaths()) {
             std::vector<NearestTwo> rows(na);
             std::vector<int> col_best(nb, -7), col_index(nb, -7);
-            (path == 0 ? nearestBothWays : nearestBothWaysPortable)(a.data(), na, b.data(), nb, row_bound, col_bound,
-                                                                    rows.data(), col_best.data(), col_index.data());
+            nearestBothWaysOn(path, a.data(), na, b.data(), nb, row_bound, col_bound, rows.data(), col_best.data(),
+                              col_index.data());
             for (std::size_t k = 0; k < na; ++k)
-              expectSame(rows[k], sortedNearestTwo(a[k], b, row_bound), path == 0 ? "rows" : "portable rows", trial);
+              expectSame(rows[k], sortedNearestTwo(row_distances[k], row_bound), "rows", trial);
             for (std::size_t l = 0; l < nb; ++l) {
               int best = col_bound, index = -1;
               for (std::size_t k = 0; k < na; ++k) {
-                const int dist = bitDistance(a[k], b[l]);
+                const int dist = row_distances[k][l];
                 if (dist < best) {
                   best = dist;
                   index = int(k);
                 }
               }
-              ASSERT_EQ(col_best[l], best) << "trial " << trial << " path " << path << " column " << l;
-              ASSERT_EQ(col_index[l], index) << "trial " << trial << " path " << path << " column " << l;
+              ASSERT_EQ(col_best[l], best) << "trial " << trial << " path " << int(path) << " column " << l;
+              ASSERT_EQ(col_index[l], index) << "trial " << trial << " path " << int(path) << " column " << l;
               columns_set += index >= 0;
             }
           }
@@ -249,22 +269,36 @@ TEST(DescriptorMatch, NearestBothWaysEqualsRowAndColumnDefinitions) {
 
 // The context check's mutual matches (loop_context_check.cpp) as they were computed before: full
 // row and column scans from 257, the row's ratio test, the column's best index.
-std::vector<std::pair<int, int>> mutualMatchesBefore(const std::vector<Descriptor256>& a,
-                                                     const std::vector<Descriptor256>& b, int threshold, float ratio) {
-  std::vector<int> best_j(b.size(), 257), index_j(b.size(), 0);
+std::vector<std::pair<int, int>> mutualMatchesBefore(const std::vector<std::vector<int>>& distances, std::size_t nb,
+                                                     int threshold, float ratio) {
+  std::vector<int> best_j(nb, 257), index_j(nb, 0);
   std::vector<std::pair<int, int>> out;
   std::vector<NearestTwo> rows;
-  for (std::size_t k = 0; k < a.size(); ++k) {
-    rows.push_back(plainNearestTwo(a[k], b, 257));
-    for (std::size_t l = 0; l < b.size(); ++l) {
-      const int d = bitDistance(a[k], b[l]);
+  for (std::size_t k = 0; k < distances.size(); ++k) {
+    NearestTwo r;
+    r.best = r.second = 257;
+    for (std::size_t l = 0; l < nb; ++l) {
+      const int d = distances[k][l];
+      if (d < r.best) {
+        r.second = r.best;
+        r.second_index = r.best_index;
+        r.best = d;
+        r.best_index = int(l);
+      } else if (d < r.second) {
+        r.second = d;
+        r.second_index = int(l);
+      }
+    }
+    rows.push_back(r);
+    for (std::size_t l = 0; l < nb; ++l) {
+      const int d = distances[k][l];
       if (d < best_j[l]) {
         best_j[l] = d;
         index_j[l] = int(k);
       }
     }
   }
-  for (std::size_t k = 0; k < a.size(); ++k) {
+  for (std::size_t k = 0; k < distances.size(); ++k) {
     const int d = rows[k].best;
     if (d > threshold || float(d) >= ratio * float(rows[k].second)) continue;
     if (index_j[std::size_t(rows[k].best_index)] != int(k)) continue;
@@ -283,25 +317,29 @@ TEST(DescriptorMatch, BoundedBothWaysGivesTheContextChecksMutualMatches) {
         for (int b = 0; b < 3 + 20 * rep; ++b) bases.push_back(sets.random());
         const int max_flips = 8 + 12 * rep;
         const std::vector<Descriptor256> a = sets.set(na, bases, max_flips), b = sets.set(nb, bases, max_flips);
+        std::vector<std::vector<int>> distances;  // [k][l]
+        for (const Descriptor256& d : a) distances.push_back(bitDistances(d, b));
         for (int threshold : {-1, 0, 30, 50, 256}) {
           for (float ratio : {0.8f, 0.9f}) {
             // The bounds loop_context_check.cpp passes.
             const int row_bound = ratioBound(threshold, ratio, 257);
             const int col_bound = std::min(std::max(threshold, -1) + 1, 257);
-            std::vector<NearestTwo> rows(na);
-            std::vector<int> col_best(nb), col_index(nb);
-            nearestBothWays(a.data(), na, b.data(), nb, row_bound, col_bound, rows.data(), col_best.data(),
-                            col_index.data());
-            std::vector<std::pair<int, int>> got;
-            for (std::size_t k = 0; k < na; ++k) {
-              const int d = rows[k].best;
-              if (d > threshold || float(d) >= ratio * float(rows[k].second)) continue;
-              if (col_index[std::size_t(rows[k].best_index)] != int(k)) continue;
-              got.emplace_back(int(k), rows[k].best_index);
-            }
-            const auto expected = mutualMatchesBefore(a, b, threshold, ratio);
-            ASSERT_EQ(got, expected) << "trial " << trial << " threshold " << threshold;
+            const auto expected = mutualMatchesBefore(distances, nb, threshold, ratio);
             matches += int(expected.size());
+            for (DescriptorScanPath path : availablePaths()) {
+              std::vector<NearestTwo> rows(na);
+              std::vector<int> col_best(nb), col_index(nb);
+              nearestBothWaysOn(path, a.data(), na, b.data(), nb, row_bound, col_bound, rows.data(), col_best.data(),
+                                col_index.data());
+              std::vector<std::pair<int, int>> got;
+              for (std::size_t k = 0; k < na; ++k) {
+                const int d = rows[k].best;
+                if (d > threshold || float(d) >= ratio * float(rows[k].second)) continue;
+                if (col_index[std::size_t(rows[k].best_index)] != int(k)) continue;
+                got.emplace_back(int(k), rows[k].best_index);
+              }
+              ASSERT_EQ(got, expected) << "trial " << trial << " threshold " << threshold << " path " << int(path);
+            }
           }
         }
       }
