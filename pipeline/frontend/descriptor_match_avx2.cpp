@@ -3,7 +3,8 @@
 // counts by pshufb, bytes summed by psadbw, the four sums gathered into one vector), against the
 // scan's current limit in one comparison. A block of four with a distance below the limit goes
 // through the scalar updates in index order, with the limit as it is at each one, exactly as the
-// one-at-a-time scan (which skips only what cannot change a result): the same results.
+// one-at-a-time scan (which skips only what cannot change a result): the same results. The
+// both-ways scan updates four columns' bests at once (min and blend).
 #include "pipeline/frontend/descriptor_match_avx2.h"
 
 #if PLUMB_SCAN_AVX2
@@ -87,31 +88,39 @@ PLUMB_AVX2_TARGET void nearestBothWays(const Descriptor256* a, std::size_t na, c
     NearestTwo r;
     r.best = r.second = row_bound;
     const __m256i q = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(a[k].words.data()));
-    // A pair changes its row only below the row's second best and its column only below the
-    // column's best, which is <= col_bound: nothing at or above the larger of the two.
-    int limit = r.second > col_bound ? r.second : col_bound;
-    auto visit = [&](int dist, std::size_t l) {
-      if (dist >= limit) return;
-      if (dist < r.second) {
-        update(r, dist, int(l));
-        limit = r.second > col_bound ? r.second : col_bound;
+    const __m128i row_index = _mm_set1_epi32(int(k));
+    __m128i second4 = _mm_set1_epi32(r.second);
+    // Four columns a step: a column's update (strictly below its best, this row's index) does not
+    // depend on the row's state, so the four are updated at once; the row's updates go through
+    // the scalar rule in index order, only where a distance is below its second best.
+    for (const Descriptor256* p = b; p != blocks_end; p += 4) {
+      const __m128i dist = fourDistances(q, p);
+      const std::size_t l = std::size_t(p - b);
+      __m128i* const best4 = reinterpret_cast<__m128i*>(col_best + l);
+      const __m128i cols = _mm_loadu_si128(best4);
+      const __m128i col_lower = _mm_cmpgt_epi32(cols, dist);
+      const __m128i row_lower = _mm_cmpgt_epi32(second4, dist);
+      if (_mm_movemask_epi8(_mm_or_si128(col_lower, row_lower)) == 0) continue;
+      if (_mm_movemask_epi8(col_lower) != 0) {
+        __m128i* const index4 = reinterpret_cast<__m128i*>(col_index + l);
+        _mm_storeu_si128(best4, _mm_min_epi32(cols, dist));
+        _mm_storeu_si128(index4, _mm_blendv_epi8(_mm_loadu_si128(index4), row_index, col_lower));
       }
+      if (_mm_movemask_epi8(row_lower) != 0) {
+        alignas(16) int four[4];
+        _mm_store_si128(reinterpret_cast<__m128i*>(four), dist);
+        for (int i = 0; i < 4; ++i) update(r, four[i], int(l) + i);
+        second4 = _mm_set1_epi32(r.second);
+      }
+    }
+    for (std::size_t l = nb & ~std::size_t(3); l < nb; ++l) {
+      const int dist = distance(a[k], b[l]);
+      update(r, dist, int(l));
       if (dist < col_best[l]) {
         col_best[l] = dist;
         col_index[l] = int(k);
       }
-    };
-    __m128i limit4 = _mm_set1_epi32(limit);
-    for (const Descriptor256* p = b; p != blocks_end; p += 4) {
-      const __m128i dist = fourDistances(q, p);
-      if (_mm_movemask_epi8(_mm_cmpgt_epi32(limit4, dist)) == 0) continue;
-      alignas(16) int four[4];
-      _mm_store_si128(reinterpret_cast<__m128i*>(four), dist);
-      const std::size_t l = std::size_t(p - b);
-      for (std::size_t i = 0; i < 4; ++i) visit(four[i], l + i);
-      limit4 = _mm_set1_epi32(limit);
     }
-    for (std::size_t l = nb & ~std::size_t(3); l < nb; ++l) visit(distance(a[k], b[l]), l);
     rows[k] = r;
   }
 }
