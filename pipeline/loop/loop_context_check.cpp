@@ -3,12 +3,16 @@
 #include <algorithm>
 #include <array>
 
+#include "pipeline/frontend/descriptor_match.h"
+
 namespace plumb::loop {
 
 struct LoopContextCheck::Scratch {
-  // Best and second-best distance per point of either keyframe of a pair, and the best's index.
-  std::array<int, kMaxLoopPoints> best_i{}, second_i{}, index_i{};
-  std::array<int, kMaxLoopPoints> best_j{}, second_j{}, index_j{};
+  // Per point of the query-side keyframe of a pair: its two nearest on the candidate side (below
+  // the ratio bound); per point of the candidate side: its nearest on the query side (below the
+  // Hamming threshold + 1) and that one's index.
+  std::array<NearestTwo, kMaxLoopPoints> rows{};
+  std::array<int, kMaxLoopPoints> col_best{}, col_index{};
 };
 
 LoopContextCheck::LoopContextCheck(const CameraIntrinsics& camera, const LoopContextCheckOptions& options)
@@ -27,6 +31,8 @@ LoopContextResult LoopContextCheck::evaluate(const LoopContextSide& query, const
   auto pixel = [this](const Eigen::Vector3d& P) {
     return Eigen::Vector2d(camera_.fx * P.x() / P.z() + camera_.cx, camera_.fy * P.y() / P.z() + camera_.cy);
   };
+  const int row_bound = ratioBound(options_.hamming_threshold, options_.ratio, 257);
+  const int col_bound = std::min(std::max(options_.hamming_threshold, -1) + 1, 257);
   for (int qi = 0; qi < query.count; ++qi) {
     for (int cj = 0; cj < candidate.count; ++cj) {
       if (qi == 0 && cj == 0) continue;  // the verified pair
@@ -34,37 +40,21 @@ LoopContextResult LoopContextCheck::evaluate(const LoopContextSide& query, const
       const LoopCandidate& b = *candidate.records[cj];
       if (a.num_points == 0 || b.num_points == 0) continue;
       ++r.pairs;
-      std::fill_n(s.best_i.begin(), a.num_points, 257);
-      std::fill_n(s.second_i.begin(), a.num_points, 257);
-      std::fill_n(s.best_j.begin(), b.num_points, 257);
-      std::fill_n(s.second_j.begin(), b.num_points, 257);
-      for (int k = 0; k < a.num_points; ++k) {
-        for (int l = 0; l < b.num_points; ++l) {
-          const int d = hammingDistance(a.point_descriptors[std::size_t(k)], b.point_descriptors[std::size_t(l)]);
-          if (d < s.best_i[std::size_t(k)]) {
-            s.second_i[std::size_t(k)] = s.best_i[std::size_t(k)];
-            s.best_i[std::size_t(k)] = d;
-            s.index_i[std::size_t(k)] = l;
-          } else if (d < s.second_i[std::size_t(k)]) {
-            s.second_i[std::size_t(k)] = d;
-          }
-          if (d < s.best_j[std::size_t(l)]) {
-            s.second_j[std::size_t(l)] = s.best_j[std::size_t(l)];
-            s.best_j[std::size_t(l)] = d;
-            s.index_j[std::size_t(l)] = k;
-          } else if (d < s.second_j[std::size_t(l)]) {
-            s.second_j[std::size_t(l)] = d;
-          }
-        }
-      }
+      // Both ways in one pass over the pairs (pipeline/frontend/descriptor_match.h). A row's match
+      // is decided by its best within the threshold and the ratio test, which scanning below
+      // ratioBound() keeps exact; a column is read only at a row's best within the threshold, so
+      // only column distances <= threshold matter (the mutual-best test compares indices).
+      nearestBothWays(a.point_descriptors.data(), a.num_points, b.point_descriptors.data(), b.num_points, row_bound,
+                      col_bound, s.rows.data(), s.col_best.data(), s.col_index.data());
       // Relative poses of the pair: i's camera points into j's camera, before and after.
       const Eigen::Isometry3d T_ji_before = candidate.T_world_before[cj].inverse() * query.T_world_before[qi];
       const Eigen::Isometry3d T_ji_after = candidate.T_world_after[cj].inverse() * query.T_world_after[qi];
       for (int k = 0; k < a.num_points; ++k) {
-        const int l = s.index_i[std::size_t(k)];
-        const int d = s.best_i[std::size_t(k)];
-        if (d > options_.hamming_threshold || float(d) >= options_.ratio * float(s.second_i[std::size_t(k)])) continue;
-        if (s.index_j[std::size_t(l)] != k) continue;  // mutual best only
+        const NearestTwo& row = s.rows[std::size_t(k)];
+        const int d = row.best;
+        if (d > options_.hamming_threshold || float(d) >= options_.ratio * float(row.second)) continue;
+        const int l = row.best_index;
+        if (s.col_index[std::size_t(l)] != k) continue;  // mutual best only
         ++r.matches;
         const Eigen::Vector3d P_i = a.P_cam[std::size_t(k)].cast<double>();
         const Eigen::Vector3d P_j = b.P_cam[std::size_t(l)].cast<double>();

@@ -236,9 +236,12 @@ LoopMeasurement LoopVerifier::verify(const LoopKeyframe& query, const LoopCandid
     s.candidate_octave[std::size_t(n)] = candidate.point_octave[std::size_t(j)];
     ++n;
   };
+  // Below this bound the scan decides every match as the full one (ratioBound: best within the
+  // threshold, the ratio test, and a second best within the threshold for the ambiguous pairs).
+  const int bound = ratioBound(options_.hamming_threshold, options_.ratio);
   for (std::size_t k = 0; k < query.points.size(); ++k) {
-    const NearestTwo nearest =
-        nearestTwo(query.point_descriptors[k], candidate.point_descriptors.data(), candidate.num_points);
+    const NearestTwo nearest = nearestTwoBelow(query.point_descriptors[k], candidate.point_descriptors.data(),
+                                               candidate.num_points, bound);
     if (nearest.best_index < 0 || nearest.best > options_.hamming_threshold) continue;
     const bool clear = passesRatio(nearest, options_.ratio);
     const bool ambiguous = !clear && options_.ambiguous_pairs && nearest.second <= options_.hamming_threshold;
