@@ -27,6 +27,7 @@ void LocalBundleAdjuster::reserve(int max_keyframes, int max_landmarks, int max_
   observation_order_.resize(observations_.size());
   landmark_scratch_.resize(observations_.size());
   landmark_scratch_obs_.resize(observations_.size());
+  landmark_scratch_u_.resize(observations_.size());
   variable_keyframe_.resize(keyframes_.size());
   const Eigen::Index max_dim = 6 * static_cast<Eigen::Index>(keyframes_.size());
   S_.setZero(max_dim, max_dim);

@@ -285,6 +285,7 @@ class LocalBundleAdjuster {
   std::vector<int> observation_order_;  // observation indices grouped by landmark
   std::vector<int> landmark_scratch_;   // one landmark's observations in free keyframes: variables
   std::vector<Observation*> landmark_scratch_obs_;  // ... and the observations
+  std::vector<const double*> landmark_scratch_u_;   // a run of line-sample landmarks' u (solveDamped)
   std::vector<int> variable_keyframe_;  // pose variable -> keyframe
   Eigen::MatrixXd S_;                   // reduced camera system / its Cholesky factor
   Eigen::VectorXd rhs_;                 // right-hand side / pose step of the reduced system

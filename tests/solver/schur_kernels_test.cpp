@@ -4,7 +4,10 @@
 // (solver/schur_kernels.h; its diagonal-block variant writes the lower triangle only). They
 // compute the same sums in another order, so the comparisons are to a relative 1e-12, which any
 // wrong index or sign misses by far.
+#include <cmath>
+#include <cstring>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -286,6 +289,56 @@ TEST(SolverKernels, RankOneLineSampleBlocksEqualTheGeneralForms) {
             << n << " (" << row << ", " << col << ")";
       }
     }
+  }
+}
+
+// The run kernels (a line's samples written block by block, issue 22) against the single-update
+// kernels they replace, called once per landmark in order: the same bits, not just close values
+// (local BA's output must not change), and nothing outside the block or, for the diagonal block,
+// outside the entries subtractScaledOuterLower writes.
+void expectSameBits(const Eigen::MatrixXd& got, const Eigen::MatrixXd& expected, int trial) {
+#if defined(__x86_64__) && !defined(__FMA__)
+  for (Eigen::Index i = 0; i < got.size(); ++i) {
+    ASSERT_EQ(std::memcmp(&got(i), &expected(i), sizeof(double)), 0) << trial << " " << i;
+  }
+#else  // (as DenseCholesky's test: where GCC fuses a - x * t, the two forms may fuse differently)
+  ASSERT_LT((got - expected).norm(), 1e-12 * std::max(1.0, expected.norm())) << trial;
+#endif
+}
+
+TEST(SolverKernels, RunKernelsEqualOneUpdateAtATimeBitForBit) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    const int count = 1 + trial % 32;
+    const int width = 1 + trial % 5;  // observations per landmark: u[l * width + index]
+    const Eigen::Index stride = 6 + trial % 7;
+    std::vector<double> storage(static_cast<std::size_t>(count * width * 6));
+    for (double& x : storage) x = unit(rng) * std::pow(10.0, 3.0 * unit(rng));
+    std::vector<const double*> u(static_cast<std::size_t>(count * width));
+    for (std::size_t i = 0; i < u.size(); ++i) u[i] = storage.data() + 6 * i;
+    std::vector<double> gamma(static_cast<std::size_t>(count));
+    for (double& g : gamma) g = unit(rng);
+    const int x_index = trial % width, y_index = (trial / 3) % width;
+    Eigen::MatrixXd start(stride, 8);
+    for (Eigen::Index i = 0; i < start.size(); ++i) start(i) = unit(rng);
+
+    Eigen::MatrixXd got = start, expected = start;
+    subtractScaledOuterRun(count, gamma.data(), u.data(), width, x_index, y_index, got.data() + 1, stride);
+    for (int l = 0; l < count; ++l) {
+      subtractScaledOuter(gamma[l], u[l * width + x_index], u[l * width + y_index], expected.data() + 1, stride);
+    }
+    expectSameBits(got, expected, trial);
+    ASSERT_NE(std::memcmp(got.data(), start.data(), sizeof(double) * got.size()), 0) << trial;
+
+    Eigen::MatrixXd got_lower = start, expected_lower = start;
+    subtractScaledOuterLowerRun(count, gamma.data(), u.data(), width, x_index, got_lower.data() + 1, stride);
+    for (int l = 0; l < count; ++l) {
+      const double* x = u[l * width + x_index];
+      subtractScaledOuterLower(gamma[l], x, x, expected_lower.data() + 1, stride);
+    }
+    expectSameBits(got_lower, expected_lower, trial);
+    ASSERT_NE(std::memcmp(got_lower.data(), start.data(), sizeof(double) * got_lower.size()), 0) << trial;
   }
 }
 
