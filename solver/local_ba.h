@@ -299,6 +299,7 @@ class LocalBundleAdjuster {
   // The stored linearisation (blocks, IRLS weights, valid flags) is at the current estimate and
   // the observation set has not changed since: computeCovariance() can eliminate from it.
   bool linearized_at_estimate_ = false;
+  bool structure_built_ = false;  // observation_order_ and the landmarks' ranges match the problem
   InformationScales information_scales_;  // computeCovariance's; all 1 while solving
 };
 

@@ -6,12 +6,14 @@
 // wrong index or sign misses by far.
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "solver/factors.h"
+#include "solver/finite_check.h"
 #include "solver/point_space_blocks.h"
 #include "solver/schur_kernels.h"
 #include "solver/se3.h"
@@ -340,6 +342,28 @@ TEST(SolverKernels, RunKernelsEqualOneUpdateAtATimeBitForBit) {
     expectSameBits(got_lower, expected_lower, trial);
     ASSERT_NE(std::memcmp(got_lower.data(), start.data(), sizeof(double) * got_lower.size()), 0) << trial;
   }
+}
+
+TEST(SolverKernels, FiniteCheckAnswersAsEigenAllFinite) {
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const double specials[] = {std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                             std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::max(),
+                             -std::numeric_limits<double>::max(), std::numeric_limits<double>::denorm_min(), -0.0};
+  int non_finite = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const int n = 1 + trial % 13;
+    Eigen::VectorXd x(n);
+    for (int i = 0; i < n; ++i) x(i) = unit(rng) * 1e300;
+    for (int k = 0; k < trial % 3; ++k) x(static_cast<int>(rng() % n)) = specials[rng() % 7];
+    ASSERT_EQ(allFiniteValues(x.data(), n), x.allFinite()) << trial;
+    non_finite += x.allFinite() ? 0 : 1;
+  }
+  EXPECT_GT(non_finite, 100);
+  Eigen::Matrix3d H = Eigen::Matrix3d::Constant(std::numeric_limits<double>::max());
+  EXPECT_TRUE(allFiniteValues(H));  // no overflow: the entries are not summed, x - x is
+  H(2, 1) = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(allFiniteValues(H));
 }
 
 }  // namespace
