@@ -238,6 +238,7 @@ class LocalBundleAdjuster {
     Eigen::Matrix3d H_point_inv = Eigen::Matrix3d::Zero();  // damped inverse of the last elimination
     Eigen::Vector3d g_point = Eigen::Vector3d::Zero();
     Eigen::Vector3d step = Eigen::Vector3d::Zero();
+    Eigen::Vector3d damping = Eigen::Vector3d::Zero();  // LM damping of H_ll's diagonal, last elimination
     int first_observation = 0;  // into observation_order_ (landmark-major order)
     int num_observations = 0;
     bool eliminated = false;  // false: held fixed in the current linearisation

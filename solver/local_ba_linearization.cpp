@@ -232,7 +232,10 @@ bool LocalBundleAdjuster::solveDamped(const LocalBaOptions& options, double lamb
   for (int j = 0; j < num_landmarks_; ++j) {
     Landmark& lm = landmarks_[j];
     Eigen::Matrix3d H_damped = lm.H_point;
-    for (int d = 0; d < 3; ++d) H_damped(d, d) += damping(lambda, lm.H_point(d, d));
+    for (int d = 0; d < 3; ++d) {
+      lm.damping(d) = damping(lambda, lm.H_point(d, d));  // kept for modelCostReduction(lambda)
+      H_damped(d, d) += lm.damping(d);
+    }
     lm.eliminated = invertLandmarkBlock(H_damped, options.landmark_singular_threshold, &lm.H_point_inv);
     if (!lm.eliminated) {  // writes neither S nor rhs: a run goes on past it
       ++num_fixed_landmarks_;
@@ -265,7 +268,9 @@ bool LocalBundleAdjuster::solveDamped(const LocalBaOptions& options, double lamb
         rhs.segment<6>(6 * free_var[a]) += obs.V.col(2).head<3>().dot(lm.g_point) * obs.V.col(0);
       }
       if (num_free == 0) continue;
-      if (run_length > 0 && num_free == run_width && std::equal(free_var, free_var + num_free, run_var)) {
+      bool continues = run_length > 0 && num_free == run_width;  // (a loop: std::equal calls memcmp)
+      for (int a = 0; continues && a < num_free; ++a) continues = free_var[a] == run_var[a];
+      if (continues) {
         if (++run_length == kMaxRun) flush_run();
         continue;
       }
@@ -371,8 +376,8 @@ double LocalBundleAdjuster::modelCostReduction(double lambda) const {
   for (int j = 0; j < num_landmarks_; ++j) {
     const Landmark& lm = landmarks_[j];
     if (!lm.eliminated) continue;
-    for (int d = 0; d < 3; ++d) {
-      twice += damping(lambda, lm.H_point(d, d)) * lm.step(d) * lm.step(d) - lm.g_point(d) * lm.step(d);
+    for (int d = 0; d < 3; ++d) {  // the damping of the solveDamped(lambda) that gave the step
+      twice += lm.damping(d) * lm.step(d) * lm.step(d) - lm.g_point(d) * lm.step(d);
     }
   }
   return 0.5 * twice;
