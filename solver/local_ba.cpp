@@ -2,6 +2,7 @@
 // observations, the landmark-major observation order, and result accessors.
 #include <algorithm>
 
+#include "solver/finite_check.h"
 #include "solver/local_ba.h"
 
 namespace plumb {
@@ -27,6 +28,7 @@ void LocalBundleAdjuster::reserve(int max_keyframes, int max_landmarks, int max_
   observation_order_.resize(observations_.size());
   landmark_scratch_.resize(observations_.size());
   landmark_scratch_obs_.resize(observations_.size());
+  landmark_scratch_u_.resize(observations_.size());
   variable_keyframe_.resize(keyframes_.size());
   const Eigen::Index max_dim = 6 * static_cast<Eigen::Index>(keyframes_.size());
   S_.setZero(max_dim, max_dim);
@@ -43,6 +45,7 @@ void LocalBundleAdjuster::clear() {
   num_fixed_landmarks_ = 0;
   covariance_valid_ = false;
   linearized_at_estimate_ = false;
+  structure_built_ = false;
 }
 
 int LocalBundleAdjuster::addKeyframe(const Eigen::Isometry3d& T_cam_world, bool fixed) {
@@ -64,6 +67,7 @@ int LocalBundleAdjuster::addLandmark(const Eigen::Vector3d& P_world) {
   lm.step.setZero();
   lm.eliminated = false;
   linearized_at_estimate_ = false;
+  structure_built_ = false;
   return num_landmarks_++;
 }
 
@@ -71,7 +75,8 @@ int LocalBundleAdjuster::addObservation(int keyframe, int landmark, ObservationK
                                         const Eigen::Vector3d& z, const Eigen::Matrix3d& information) {
   if (num_observations_ >= static_cast<int>(observations_.size())) return -1;
   if (keyframe < 0 || keyframe >= num_keyframes_ || landmark < 0 || landmark >= num_landmarks_) return -1;
-  if (!z.allFinite() || !information.allFinite()) return -1;  // would poison the whole solve
+  // (would poison the whole solve; allFiniteValues: the same test in fewer instructions)
+  if (!(finiteResidue(z.data(), 3) + finiteResidue(information.data(), 9) == 0.0)) return -1;
   Observation& obs = observations_[num_observations_];
   obs.keyframe = keyframe;
   obs.landmark = landmark;
@@ -83,6 +88,7 @@ int LocalBundleAdjuster::addObservation(int keyframe, int landmark, ObservationK
   obs.outlier = false;
   obs.chi2 = 0.0;
   linearized_at_estimate_ = false;
+  structure_built_ = false;
   return num_observations_++;
 }
 
@@ -114,6 +120,10 @@ void LocalBundleAdjuster::setObservationEnabled(int observation, bool enabled) {
 
 // Groups observation indices by landmark (counting sort into the reserved order array).
 void LocalBundleAdjuster::buildStructure() {
+  // The order is a function of the landmarks' and observations' count and of each observation's
+  // landmark: built once after the last addition (solve() and computeCovariance() both ask).
+  if (structure_built_) return;
+  structure_built_ = true;
   for (int j = 0; j < num_landmarks_; ++j) landmarks_[j].num_observations = 0;
   for (int k = 0; k < num_observations_; ++k) ++landmarks_[observations_[k].landmark].num_observations;
   int offset = 0;

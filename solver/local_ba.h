@@ -238,6 +238,7 @@ class LocalBundleAdjuster {
     Eigen::Matrix3d H_point_inv = Eigen::Matrix3d::Zero();  // damped inverse of the last elimination
     Eigen::Vector3d g_point = Eigen::Vector3d::Zero();
     Eigen::Vector3d step = Eigen::Vector3d::Zero();
+    Eigen::Vector3d damping = Eigen::Vector3d::Zero();  // LM damping of H_ll's diagonal, last elimination
     int first_observation = 0;  // into observation_order_ (landmark-major order)
     int num_observations = 0;
     bool eliminated = false;  // false: held fixed in the current linearisation
@@ -285,6 +286,7 @@ class LocalBundleAdjuster {
   std::vector<int> observation_order_;  // observation indices grouped by landmark
   std::vector<int> landmark_scratch_;   // one landmark's observations in free keyframes: variables
   std::vector<Observation*> landmark_scratch_obs_;  // ... and the observations
+  std::vector<const double*> landmark_scratch_u_;   // a run of line-sample landmarks' u (solveDamped)
   std::vector<int> variable_keyframe_;  // pose variable -> keyframe
   Eigen::MatrixXd S_;                   // reduced camera system / its Cholesky factor
   Eigen::VectorXd rhs_;                 // right-hand side / pose step of the reduced system
@@ -298,6 +300,7 @@ class LocalBundleAdjuster {
   // The stored linearisation (blocks, IRLS weights, valid flags) is at the current estimate and
   // the observation set has not changed since: computeCovariance() can eliminate from it.
   bool linearized_at_estimate_ = false;
+  bool structure_built_ = false;  // observation_order_ and the landmarks' ranges match the problem
   InformationScales information_scales_;  // computeCovariance's; all 1 while solving
 };
 

@@ -9,6 +9,7 @@
 
 #include "solver/dense_cholesky.h"
 #include "solver/factors.h"
+#include "solver/finite_check.h"
 #include "solver/local_ba.h"
 #include "solver/noise_model.h"
 #include "solver/point_space_blocks.h"
@@ -33,7 +34,7 @@ inline double damping(double lambda, double diagonal) {
 // step along the line). Returns false for a zero or non-finite block: the landmark is then held
 // fixed (its observations still constrain the poses through H_pp).
 bool invertLandmarkBlock(const Eigen::Matrix3d& H, double singular_threshold, Eigen::Matrix3d* H_inv) {
-  if (!H.allFinite()) return false;
+  if (!allFiniteValues(H)) return false;  // H.allFinite(), in fewer instructions
   // Cholesky H = L L^T written out (Eigen's LLT of a 3x3 is a generic loop, ~3x the
   // instructions; this runs once per landmark per elimination), then H^-1 = L^-T L^-1.
   const double max_diagonal = H.diagonal().maxCoeff();
@@ -192,34 +193,72 @@ bool LocalBundleAdjuster::solveDamped(const LocalBaOptions& options, double lamb
   num_fixed_landmarks_ = 0;
   double* const S_data = S.data();
   const Eigen::Index stride = S.outerStride();
+  // 6x6 block (row_variable, col_variable) of S.
+  auto block = [S_data, stride](int row_variable, int col_variable) {
+    return S_data + 6 * (static_cast<Eigen::Index>(row_variable) + stride * col_variable);
+  };
+  // Consecutive landmarks seen only by line samples, by the same free keyframes (the samples of
+  // one line, as the local mapper adds them) update the same blocks of S. Their updates are held
+  // back as a run and then written block by block, the landmarks in order inside each block
+  // (subtractScaledOuterRun): every entry of S gets the same subtractions in the same order as
+  // landmark by landmark, but each block is loaded and stored once a run. The run's observations
+  // are the first run_length * run_width entries of the scratch lists (landmark-major); a
+  // landmark that writes S otherwise writes the run first.
+  constexpr int kMaxRun = 32;
+  int run_length = 0, run_width = 0;
+  const int* run_var = landmark_scratch_.data();
+  auto flush_run = [&]() {
+    Observation* const* run_obs = landmark_scratch_obs_.data();
+    const double** u = landmark_scratch_u_.data();
+    for (int i = 0; i < run_length * run_width; ++i) u[i] = run_obs[i]->V.data();  // column 0: u
+    double gamma[kMaxRun];
+    for (int a = 0; a < run_width; ++a) {
+      for (int l = 0; l < run_length; ++l) {
+        const Observation& obs_a = *run_obs[l * run_width + a];
+        const Eigen::Vector3d r_a = obs_a.V.col(1).head<3>();
+        gamma[l] = r_a.dot(obs_a.V.col(2).head<3>());
+      }
+      subtractScaledOuterLowerRun(run_length, gamma, u, run_width, a, block(run_var[a], run_var[a]), stride);
+      for (int b = a + 1; b < run_width; ++b) {
+        for (int l = 0; l < run_length; ++l) {
+          const Eigen::Vector3d r_a = run_obs[l * run_width + a]->V.col(1).head<3>();
+          gamma[l] = r_a.dot(run_obs[l * run_width + b]->V.col(2).head<3>());  // r_a^T H^-1 r_b
+        }
+        subtractScaledOuterRun(run_length, gamma, u, run_width, b, a, block(run_var[b], run_var[a]), stride);
+      }
+    }
+    run_length = 0;
+  };
   for (int j = 0; j < num_landmarks_; ++j) {
     Landmark& lm = landmarks_[j];
     Eigen::Matrix3d H_damped = lm.H_point;
-    for (int d = 0; d < 3; ++d) H_damped(d, d) += damping(lambda, lm.H_point(d, d));
+    for (int d = 0; d < 3; ++d) {
+      lm.damping(d) = damping(lambda, lm.H_point(d, d));  // kept for modelCostReduction(lambda)
+      H_damped(d, d) += lm.damping(d);
+    }
     lm.eliminated = invertLandmarkBlock(H_damped, options.landmark_singular_threshold, &lm.H_point_inv);
-    if (!lm.eliminated) {
+    if (!lm.eliminated) {  // writes neither S nor rhs: a run goes on past it
       ++num_fixed_landmarks_;
       continue;
     }
     // Gather the observations in free keyframes with their pose variables, so that the pair loops
-    // below read neither the observation order nor the keyframes again.
+    // below read neither the observation order nor the keyframes again (after the pending run's).
     const int* order = &observation_order_[lm.first_observation];
-    Observation** free_obs = landmark_scratch_obs_.data();
-    int* free_var = landmark_scratch_.data();
+    const int gathered_at = run_length * run_width;
+    Observation** free_obs = landmark_scratch_obs_.data() + gathered_at;
+    int* free_var = landmark_scratch_.data() + gathered_at;
     int num_free = 0;
     bool all_line_samples = true;
+    bool increasing = true;  // distinct variables, each pair of observations its own block
     for (int a = 0; a < lm.num_observations; ++a) {
       Observation& obs = observations_[order[a]];
       const int v = keyframes_[obs.keyframe].variable;
       if (!obs.valid || v < 0) continue;
       all_line_samples = all_line_samples && obs.kind == ObservationKind::kLineSample;
+      increasing = increasing && (num_free == 0 || v > free_var[num_free - 1]);
       free_obs[num_free] = &obs;
       free_var[num_free++] = v;
     }
-    // 6x6 block (row_variable, col_variable) of S.
-    auto block = [S_data, stride](int row_variable, int col_variable) {
-      return S_data + 6 * (static_cast<Eigen::Index>(row_variable) + stride * col_variable);
-    };
     if (all_line_samples) {
       // W_a = u_a r_a^T, so V_a W_b^T = u_a (r_a^T H_ll^-1 r_b) u_b^T: a scaled outer product of
       // two 6-vectors (about half the instructions of the general product); V g = u (H_ll^-1 r)^T g.
@@ -227,6 +266,21 @@ bool LocalBundleAdjuster::solveDamped(const LocalBaOptions& options, double lamb
         Observation& obs = *free_obs[a];
         obs.V.col(2).head<3>().noalias() = lm.H_point_inv * obs.V.col(1).head<3>();
         rhs.segment<6>(6 * free_var[a]) += obs.V.col(2).head<3>().dot(lm.g_point) * obs.V.col(0);
+      }
+      if (num_free == 0) continue;
+      bool continues = run_length > 0 && num_free == run_width;  // (a loop: std::equal calls memcmp)
+      for (int a = 0; continues && a < num_free; ++a) continues = free_var[a] == run_var[a];
+      if (continues) {
+        if (++run_length == kMaxRun) flush_run();
+        continue;
+      }
+      if (run_length > 0) flush_run();
+      if (increasing) {  // starts a run: move its lists to the front
+        std::copy(free_obs, free_obs + num_free, landmark_scratch_obs_.data());
+        std::copy(free_var, free_var + num_free, landmark_scratch_.data());
+        run_width = num_free;
+        run_length = 1;
+        continue;
       }
       for (int a = 0; a < num_free; ++a) {
         const Observation& obs_a = *free_obs[a];
@@ -251,6 +305,7 @@ bool LocalBundleAdjuster::solveDamped(const LocalBaOptions& options, double lamb
       }
       continue;
     }
+    if (run_length > 0) flush_run();
     // V = W H_ll^-1 and the reduced right-hand side.
     for (int a = 0; a < num_free; ++a) {
       Observation& obs = *free_obs[a];
@@ -276,6 +331,8 @@ bool LocalBundleAdjuster::solveDamped(const LocalBaOptions& options, double lamb
       }
     }
   }
+
+  if (run_length > 0) flush_run();
 
   if (dim > 0) {
     if (!choleskyInPlace(S)) return false;
@@ -319,8 +376,8 @@ double LocalBundleAdjuster::modelCostReduction(double lambda) const {
   for (int j = 0; j < num_landmarks_; ++j) {
     const Landmark& lm = landmarks_[j];
     if (!lm.eliminated) continue;
-    for (int d = 0; d < 3; ++d) {
-      twice += damping(lambda, lm.H_point(d, d)) * lm.step(d) * lm.step(d) - lm.g_point(d) * lm.step(d);
+    for (int d = 0; d < 3; ++d) {  // the damping of the solveDamped(lambda) that gave the step
+      twice += lm.damping(d) * lm.step(d) * lm.step(d) - lm.g_point(d) * lm.step(d);
     }
   }
   return 0.5 * twice;

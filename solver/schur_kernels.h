@@ -90,6 +90,92 @@ inline void subtractScaledOuterLower(double gamma, const double* x, const double
   }
 }
 
+// A run of rank-one updates of one 6x6 block, S_block -= gamma[l] x_l y_l^T for l = 0 .. count-1
+// in that order, with x_l = u[l * step + x_index] and y_l = u[l * step + y_index] (6 doubles each).
+// Every entry gets the subtractions subtractScaledOuter would give it, in the same order, so the
+// block is bit-identical to `count` calls of it; but the block stays in registers, half of it (9
+// 2-double vectors) at a time, instead of 18 loads and stores per update (issue 22, map stage).
+inline void subtractScaledOuterRun(int count, const double* gamma, const double* const* u, int step, int x_index,
+                                   int y_index, double* S, Eigen::Index stride) {
+  using namespace schur_detail;
+  for (int half = 0; half < 2; ++half) {
+    double* const s0 = S + 3 * half * stride;
+    double* const s1 = s0 + stride;
+    double* const s2 = s1 + stride;
+    Double2 a0 = load2(s0), a1 = load2(s0 + 2), a2 = load2(s0 + 4);
+    Double2 b0 = load2(s1), b1 = load2(s1 + 2), b2 = load2(s1 + 4);
+    Double2 c0 = load2(s2), c1 = load2(s2 + 2), c2 = load2(s2 + 4);
+    for (int l = 0; l < count; ++l) {
+      const double* const x = u[l * step + x_index];
+      const double* const y = u[l * step + y_index] + 3 * half;
+      const double g = gamma[l];
+      const Double2 x0 = load2(x), x1 = load2(x + 2), x2 = load2(x + 4);
+      const Double2 ta = splat(g * y[0]);
+      a0 = a0 - x0 * ta;
+      a1 = a1 - x1 * ta;
+      a2 = a2 - x2 * ta;
+      const Double2 tb = splat(g * y[1]);
+      b0 = b0 - x0 * tb;
+      b1 = b1 - x1 * tb;
+      b2 = b2 - x2 * tb;
+      const Double2 tc = splat(g * y[2]);
+      c0 = c0 - x0 * tc;
+      c1 = c1 - x1 * tc;
+      c2 = c2 - x2 * tc;
+    }
+    store2(s0, a0), store2(s0 + 2, a1), store2(s0 + 4, a2);
+    store2(s1, b0), store2(s1 + 2, b1), store2(s1 + 4, b2);
+    store2(s2, c0), store2(s2 + 2, c1), store2(s2 + 4, c2);
+  }
+}
+
+// The same on a diagonal block with x_l = y_l = u[l * step + index], lower triangle only: the
+// entries subtractScaledOuterLower writes (column c from row pair (c & ~1) down, 12 vectors),
+// all in registers at once.
+inline void subtractScaledOuterLowerRun(int count, const double* gamma, const double* const* u, int step, int index,
+                                        double* S, Eigen::Index stride) {
+  using namespace schur_detail;
+  double* const s0 = S;
+  double* const s1 = s0 + stride;
+  double* const s2 = s1 + stride;
+  double* const s3 = s2 + stride;
+  double* const s4 = s3 + stride;
+  double* const s5 = s4 + stride;
+  Double2 a0 = load2(s0), a1 = load2(s0 + 2), a2 = load2(s0 + 4);
+  Double2 b0 = load2(s1), b1 = load2(s1 + 2), b2 = load2(s1 + 4);
+  Double2 c1 = load2(s2 + 2), c2 = load2(s2 + 4);
+  Double2 d1 = load2(s3 + 2), d2 = load2(s3 + 4);
+  Double2 e2 = load2(s4 + 4);
+  Double2 f2 = load2(s5 + 4);
+  for (int l = 0; l < count; ++l) {
+    const double* const x = u[l * step + index];
+    const double g = gamma[l];
+    const Double2 x0 = load2(x), x1 = load2(x + 2), x2 = load2(x + 4);
+    const Double2 ta = splat(g * x[0]);
+    a0 = a0 - x0 * ta;
+    a1 = a1 - x1 * ta;
+    a2 = a2 - x2 * ta;
+    const Double2 tb = splat(g * x[1]);
+    b0 = b0 - x0 * tb;
+    b1 = b1 - x1 * tb;
+    b2 = b2 - x2 * tb;
+    const Double2 tc = splat(g * x[2]);
+    c1 = c1 - x1 * tc;
+    c2 = c2 - x2 * tc;
+    const Double2 td = splat(g * x[3]);
+    d1 = d1 - x1 * td;
+    d2 = d2 - x2 * td;
+    e2 = e2 - x2 * splat(g * x[4]);
+    f2 = f2 - x2 * splat(g * x[5]);
+  }
+  store2(s0, a0), store2(s0 + 2, a1), store2(s0 + 4, a2);
+  store2(s1, b0), store2(s1 + 2, b1), store2(s1 + 4, b2);
+  store2(s2 + 2, c1), store2(s2 + 4, c2);
+  store2(s3 + 2, d1), store2(s3 + 4, d2);
+  store2(s4 + 4, e2);
+  store2(s5 + 4, f2);
+}
+
 // V = W H (W 6x3, H 3x3) and rhs += V g (rhs: 6 doubles).
 inline void formVAndRhs(const Matrix63d& W, const Eigen::Matrix3d& H, const Eigen::Vector3d& g, Matrix63d* V,
                         double* rhs) {

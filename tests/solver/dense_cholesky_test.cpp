@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include <Eigen/Cholesky>
@@ -69,6 +70,47 @@ TEST(DenseCholesky, FactorEqualsTheEigenExpressionFormBitForBit) {
 #else  // aarch64 GCC fuses a - l * b differently in the two forms
       ASSERT_LT((got - expected).norm(), 1e-12 * expected.norm()) << n << " " << offset;
 #endif
+    }
+  }
+}
+
+// The form choleskyInverse had before its forward solves started at the panel of their unit
+// entry (issue 22): full solves of every unit column, then the two triangles averaged.
+void referenceCholeskyInverse(const Eigen::Ref<const Eigen::MatrixXd>& L, Eigen::Ref<Eigen::MatrixXd> inverse) {
+  inverse.setIdentity();
+  for (Eigen::Index c = 0; c < inverse.cols(); ++c) {
+    Eigen::Ref<Eigen::VectorXd> column = inverse.col(c);
+    choleskySolveInPlace(L, column);
+  }
+  for (Eigen::Index c = 0; c < inverse.cols(); ++c) {
+    for (Eigen::Index r = c + 1; r < inverse.rows(); ++r) {
+      const double mean = 0.5 * (inverse(r, c) + inverse(c, r));
+      inverse(r, c) = mean;
+      inverse(c, r) = mean;
+    }
+  }
+}
+
+TEST(DenseCholesky, InverseEqualsTheFullSolveFormBitForBit) {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  // Sizes below, at and across the solver's panel width (8), in the corner of larger buffers.
+  for (int n = 1; n <= 70; n += (n < 18 ? 1 : 6)) {
+    for (const Eigen::Index offset : {0, 3}) {
+      Eigen::MatrixXd B(n, n);
+      for (Eigen::Index i = 0; i < B.size(); ++i) B(i) = u(rng);
+      Eigen::MatrixXd buffer = Eigen::MatrixXd::Constant(n + offset + 2, n + offset + 1, 5.0);
+      buffer.block(offset, offset, n, n) = B * B.transpose() + 0.1 * Eigen::MatrixXd::Identity(n, n);
+      ASSERT_TRUE(choleskyInPlace(buffer.block(offset, offset, n, n)));
+      Eigen::MatrixXd got = Eigen::MatrixXd::Constant(n + 1, n + 2, -3.0);
+      Eigen::MatrixXd expected = got;
+      choleskyInverse(buffer.block(offset, offset, n, n), got.topLeftCorner(n, n));
+      referenceCholeskyInverse(buffer.block(offset, offset, n, n), expected.topLeftCorner(n, n));
+      // Bits, not values: a changed sign of a zero would count too.
+      for (Eigen::Index i = 0; i < got.size(); ++i) {
+        ASSERT_EQ(std::memcmp(&got(i), &expected(i), sizeof(double)), 0)
+            << n << " " << offset << " " << i << ": " << got(i) << " vs " << expected(i);
+      }
     }
   }
 }

@@ -4,11 +4,16 @@
 // (solver/schur_kernels.h; its diagonal-block variant writes the lower triangle only). They
 // compute the same sums in another order, so the comparisons are to a relative 1e-12, which any
 // wrong index or sign misses by far.
+#include <cmath>
+#include <cstring>
+#include <limits>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "solver/factors.h"
+#include "solver/finite_check.h"
 #include "solver/point_space_blocks.h"
 #include "solver/schur_kernels.h"
 #include "solver/se3.h"
@@ -287,6 +292,78 @@ TEST(SolverKernels, RankOneLineSampleBlocksEqualTheGeneralForms) {
       }
     }
   }
+}
+
+// The run kernels (a line's samples written block by block, issue 22) against the single-update
+// kernels they replace, called once per landmark in order: the same bits, not just close values
+// (local BA's output must not change), and nothing outside the block or, for the diagonal block,
+// outside the entries subtractScaledOuterLower writes.
+void expectSameBits(const Eigen::MatrixXd& got, const Eigen::MatrixXd& expected, int trial) {
+#if defined(__x86_64__) && !defined(__FMA__)
+  for (Eigen::Index i = 0; i < got.size(); ++i) {
+    ASSERT_EQ(std::memcmp(&got(i), &expected(i), sizeof(double)), 0) << trial << " " << i;
+  }
+#else  // (as DenseCholesky's test: where GCC fuses a - x * t, the two forms may fuse differently)
+  ASSERT_LT((got - expected).norm(), 1e-12 * std::max(1.0, expected.norm())) << trial;
+#endif
+}
+
+TEST(SolverKernels, RunKernelsEqualOneUpdateAtATimeBitForBit) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    const int count = 1 + trial % 32;
+    const int width = 1 + trial % 5;  // observations per landmark: u[l * width + index]
+    const Eigen::Index stride = 6 + trial % 7;
+    std::vector<double> storage(static_cast<std::size_t>(count * width * 6));
+    for (double& x : storage) x = unit(rng) * std::pow(10.0, 3.0 * unit(rng));
+    std::vector<const double*> u(static_cast<std::size_t>(count * width));
+    for (std::size_t i = 0; i < u.size(); ++i) u[i] = storage.data() + 6 * i;
+    std::vector<double> gamma(static_cast<std::size_t>(count));
+    for (double& g : gamma) g = unit(rng);
+    const int x_index = trial % width, y_index = (trial / 3) % width;
+    Eigen::MatrixXd start(stride, 8);
+    for (Eigen::Index i = 0; i < start.size(); ++i) start(i) = unit(rng);
+
+    Eigen::MatrixXd got = start, expected = start;
+    subtractScaledOuterRun(count, gamma.data(), u.data(), width, x_index, y_index, got.data() + 1, stride);
+    for (int l = 0; l < count; ++l) {
+      subtractScaledOuter(gamma[l], u[l * width + x_index], u[l * width + y_index], expected.data() + 1, stride);
+    }
+    expectSameBits(got, expected, trial);
+    ASSERT_NE(std::memcmp(got.data(), start.data(), sizeof(double) * got.size()), 0) << trial;
+
+    Eigen::MatrixXd got_lower = start, expected_lower = start;
+    subtractScaledOuterLowerRun(count, gamma.data(), u.data(), width, x_index, got_lower.data() + 1, stride);
+    for (int l = 0; l < count; ++l) {
+      const double* x = u[l * width + x_index];
+      subtractScaledOuterLower(gamma[l], x, x, expected_lower.data() + 1, stride);
+    }
+    expectSameBits(got_lower, expected_lower, trial);
+    ASSERT_NE(std::memcmp(got_lower.data(), start.data(), sizeof(double) * got_lower.size()), 0) << trial;
+  }
+}
+
+TEST(SolverKernels, FiniteCheckAnswersAsEigenAllFinite) {
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const double specials[] = {std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                             std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::max(),
+                             -std::numeric_limits<double>::max(), std::numeric_limits<double>::denorm_min(), -0.0};
+  int non_finite = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const int n = 1 + trial % 13;
+    Eigen::VectorXd x(n);
+    for (int i = 0; i < n; ++i) x(i) = unit(rng) * 1e300;
+    for (int k = 0; k < trial % 3; ++k) x(static_cast<int>(rng() % n)) = specials[rng() % 7];
+    ASSERT_EQ(allFiniteValues(x.data(), n), x.allFinite()) << trial;
+    non_finite += x.allFinite() ? 0 : 1;
+  }
+  EXPECT_GT(non_finite, 100);
+  Eigen::Matrix3d H = Eigen::Matrix3d::Constant(std::numeric_limits<double>::max());
+  EXPECT_TRUE(allFiniteValues(H));  // no overflow: the entries are not summed, x - x is
+  H(2, 1) = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(allFiniteValues(H));
 }
 
 }  // namespace

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <random>
 
 #include "solver/noise_model.h"
@@ -102,6 +104,73 @@ TEST(VarianceFactor, StereoInformationSplitsIntoPixelAndDepth) {
   splitStereoChi2(depth_scaled, e, &pixel2, &depth2);
   EXPECT_NEAR(pixel2, pixel, 1e-9 * pixel);
   EXPECT_NEAR(depth2, 0.25 * depth, 1e-9 * depth);
+}
+
+// The matrix form scaleStereoInformation had before it was written out for the model's zeros
+// (issue 22): every product of 0 or +-1 computed, so the signs of zero results are its own.
+Eigen::Matrix3d referenceScaleStereoInformation(const Eigen::Matrix3d& information, double pixel_scale,
+                                                double depth_scale) {
+  Eigen::Matrix3d T = Eigen::Matrix3d::Identity();
+  T(2, 0) = 1.0;
+  T(2, 2) = -1.0;
+  const Eigen::Vector3d d(std::sqrt(pixel_scale), std::sqrt(pixel_scale), std::sqrt(depth_scale));
+  const Eigen::Matrix3d information_y = d.asDiagonal() * (T.transpose() * information * T) * d.asDiagonal();
+  return T.transpose() * information_y * T;
+}
+
+void expectSameBits(const Eigen::Matrix3d& got, const Eigen::Matrix3d& expected, int trial) {
+  for (int i = 0; i < 9; ++i) {
+    ASSERT_EQ(std::memcmp(&got(i), &expected(i), sizeof(double)), 0)
+        << trial << " entry " << i << ": " << got(i) << " vs " << expected(i);
+  }
+}
+
+TEST(VarianceFactor, ScaledStereoInformationEqualsTheMatrixFormBitForBit) {
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const CameraIntrinsics camera{525.0, 525.0, 319.5, 239.5, 525.0 * 0.08};
+  const NoiseModelOptions noise;
+  auto scale = [&]() { return std::pow(10.0, 2.0 * unit(rng)); };
+  for (int trial = 0; trial < 4000; ++trial) {
+    Eigen::Matrix3d information;
+    switch (trial % 4) {
+      case 0:  // the model's (its disparity part cancels exactly in T^T I T)
+        information = stereoPointInformation(noise, camera, trial % 8, 0.3 + 6.0 * std::abs(unit(rng)));
+        break;
+      case 1: {  // the model's zeros; other entries of any sign, with exact cancellations and zeros
+        const double v[] = {unit(rng), unit(rng), unit(rng), unit(rng), unit(rng)};
+        information << v[0], 0.0, v[1], 0.0, v[2], 0.0, v[3], 0.0, v[4];
+        if (trial % 3 == 0) information(2, 0) = -information(0, 0);
+        if (trial % 5 == 0) information(0, 2) = -information(2, 2);
+        if (trial % 7 == 0) information(1, 1) = trial % 2 ? 0.0 : -0.0;
+        if (trial % 11 == 0) information(0, 0) = -0.0;
+        if (trial % 13 == 0) information(2, 2) = -0.0;
+        break;
+      }
+      case 2:  // general (the matrix form itself)
+        for (int i = 0; i < 9; ++i) information(i) = unit(rng);
+        break;
+      default:  // a -0 where the model has +0, or a non-finite entry: the matrix form too
+        information = stereoPointInformation(noise, camera, 0, 1.0 + std::abs(unit(rng)));
+        if (trial % 8 == 3) information(1, 2) = -0.0;
+        if (trial % 8 == 7) information(0, 0) = std::numeric_limits<double>::infinity();
+        break;
+    }
+    const double pixel = trial % 9 == 0 ? 1.0 : scale();
+    const double depth = trial % 10 == 0 ? 1.0 : scale();
+    expectSameBits(scaleStereoInformation(information, pixel, depth),
+                   referenceScaleStereoInformation(information, pixel, depth), trial);
+  }
+  // Scales that are zero, negative or not finite take the matrix form.
+  const Eigen::Matrix3d information = stereoPointInformation(noise, camera, 1, 2.0);
+  for (const double s : {0.0, -1.0, std::numeric_limits<double>::infinity()}) {
+    const Eigen::Matrix3d got = scaleStereoInformation(information, s, 2.0);
+    const Eigen::Matrix3d expected = referenceScaleStereoInformation(information, s, 2.0);
+    for (int i = 0; i < 9; ++i) {
+      EXPECT_TRUE(std::memcmp(&got(i), &expected(i), sizeof(double)) == 0 || (std::isnan(got(i)) && std::isnan(expected(i))))
+          << s << " " << i;
+    }
+  }
 }
 
 }  // namespace
