@@ -19,7 +19,10 @@ const BACKGROUND = [16, 18, 24];
 const CHROMIUM_FLAGS = ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
                         '--disable-background-networking', '--disable-component-update', '--disable-sync'];
 
-async function openPage(port, minPoses, screenshot) {
+// The browser starts before plumb does: a live run lasts seconds, and chromium's start on a loaded
+// 2-core CI machine can take as long, so a page opened only after the run started could find the
+// server already gone (CI saw this as a 90 s wait for poses that never came).
+async function withBrowser(body) {
   const profile = fs.mkdtempSync(path.join(os.tmpdir(), 'plumb-viewer-chromium-'));
   const context = await chromium.launchPersistentContext(profile, {
     executablePath: '/usr/bin/chromium', headless: true, args: CHROMIUM_FLAGS, viewport: { width: 1000, height: 700 },
@@ -28,18 +31,23 @@ async function openPage(port, minPoses, screenshot) {
     const page = await context.newPage();
     const errors = [];
     page.on('pageerror', (e) => errors.push(e.message));
-    await page.goto(`http://127.0.0.1:${port}/`);
-    await page.waitForFunction((n) => window.plumbViewer && window.plumbViewer.posesDrawn >= n, minPoses,
-                               { timeout: 90000, polling: 200 });
-    await page.waitForTimeout(1500);  // the follow-camera settles, a frame renders
-    const stats = await page.evaluate(() => ({ ...window.plumbViewer, status: window.plumbViewer.status }));
-    await page.screenshot({ path: screenshot });
-    check(errors.length === 0, `page errors: ${errors.join('; ')}`);
-    return stats;
+    return await body(page, errors);
   } finally {
     await context.close();
     fs.rmSync(profile, { recursive: true, force: true });
   }
+}
+
+// Opens the served page, waits until it drew minPoses poses, takes a screenshot, returns its counters.
+async function showPage(page, errors, port, minPoses, screenshot) {
+  await page.goto(`http://127.0.0.1:${port}/`);
+  await page.waitForFunction((n) => window.plumbViewer && window.plumbViewer.posesDrawn >= n, minPoses,
+                             { timeout: 90000, polling: 200 });
+  await page.waitForTimeout(1500);  // the follow-camera settles, a frame renders
+  const stats = await page.evaluate(() => ({ ...window.plumbViewer, status: window.plumbViewer.status }));
+  await page.screenshot({ path: screenshot });
+  check(errors.length === 0, `page errors: ${errors.join('; ')}`);
+  return stats;
 }
 
 function pixelsOf(file, named) {
@@ -50,11 +58,21 @@ function pixelsOf(file, named) {
 }
 
 async function live(plumb, work) {
-  const run = await startServing(plumb, ['run', '--dataset', 'paced:synth:textured:1:150', '--mode', 'fast',
-                                         '--out', path.join(work, 'live.txt'), '--serve', '0']);
-  const stats = await openPage(run.port, 60, path.join(work, 'live.png'));
-  const { code } = await run.exited;
-  check(code === 0, `plumb run exited ${code}:\n${run.output()}`);
+  // 300 frames paced at 30 Hz: a 10 s run, time enough for the page to connect while it lasts.
+  const { stats, code, output } = await withBrowser(async (page, errors) => {
+    const run = await startServing(plumb, ['run', '--dataset', 'paced:synth:textured:1:300', '--mode', 'fast',
+                                           '--out', path.join(work, 'live.txt'), '--serve', '0']);
+    let shown;
+    try {
+      shown = await showPage(page, errors, run.port, 60, path.join(work, 'live.png'));
+    } catch (e) {
+      run.child.kill('SIGTERM');
+      throw e;
+    }
+    const { code } = await run.exited;
+    return { stats: shown, code, output: run.output() };
+  });
+  check(code === 0, `plumb run exited ${code}:\n${output}`);
   const px = pixelsOf(path.join(work, 'live.png'), { output: [51, 204, 89], tracked: [255, 153, 25] });
   check(px.counts.output + px.counts.tracked > 300,
         `trajectory not drawn: ${px.counts.output} output and ${px.counts.tracked} tracked pixels`);
@@ -72,16 +90,19 @@ async function view(plumb, work) {
   run(['synth', '--preset', 'textured', '--seed', '2', '--frames', '120', '--depth-noise', '--pixel-noise', '1', '--out', scene]);
   const est = path.join(work, 'estimate.txt'), map = path.join(work, 'run.map'), stats = path.join(work, 'run.json');
   run(['run', '--dataset', scene, '--out', est, '--save-map', map, '--stats', stats]);
-  const served = await startServing(plumb, ['view', '--out', est, '--gt', path.join(scene, 'groundtruth.txt'),
-                                            '--map', map, '--stats', stats, '--serve', '0']);
-  let page;
-  try {
-    page = await openPage(served.port, 100, path.join(work, 'view.png'));
-  } finally {
-    served.child.kill('SIGTERM');
-  }
-  const { code } = await served.exited;
-  check(code === 0, `plumb view exited ${code} on SIGTERM:\n${served.output()}`);
+  const { page, code, output } = await withBrowser(async (browserPage, errors) => {
+    const served = await startServing(plumb, ['view', '--out', est, '--gt', path.join(scene, 'groundtruth.txt'),
+                                              '--map', map, '--stats', stats, '--serve', '0']);
+    let shown;
+    try {
+      shown = await showPage(browserPage, errors, served.port, 100, path.join(work, 'view.png'));
+    } finally {
+      served.child.kill('SIGTERM');
+    }
+    const { code } = await served.exited;
+    return { page: shown, code, output: served.output() };
+  });
+  check(code === 0, `plumb view exited ${code} on SIGTERM:\n${output}`);
   // Error colours run green -> yellow -> red; ground truth is grey.
   const px = pixelsOf(path.join(work, 'view.png'), {
     low_error: [48, 191, 97], mid_error: [240, 209, 64], high_error: [240, 64, 64], ground_truth: [191, 191, 199],
