@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "pipeline/frontend/line_fit3d.h"
+#include "pipeline/frontend/round_half_away.h"
 #include "solver/noise_model.h"
 
 namespace plumb {
@@ -36,7 +37,7 @@ float DepthSampler::depthAt(const cv::Mat& depth_raw, double depth_factor, float
     const float ax = xf - x0, ay = yf - y0;
     return (1 - ay) * ((1 - ax) * d00 + ax * d10) + ay * ((1 - ax) * d01 + ax * d11);
   }
-  const int x = static_cast<int>(std::lround(xf)), y = static_cast<int>(std::lround(yf));
+  const int x = static_cast<int>(roundHalfAwayFromZero(xf)), y = static_cast<int>(roundHalfAwayFromZero(yf));
   const float centre = read(x, y);
   if (!prefer_near_surface) return centre;
   // Nearest valid reading in the (2r+1)^2 window, 0 if none.
@@ -73,7 +74,7 @@ float DepthSampler::depthAt(const cv::Mat& depth_raw, double depth_factor, float
 bool DepthSampler::onDepthEdge(const cv::Mat& depth_raw, double depth_factor, const Eigen::Vector2f& px) const {
   const int r = options_.keypoint_edge_radius_px;
   if (r <= 0) return false;
-  const int x = static_cast<int>(std::lround(px.x())), y = static_cast<int>(std::lround(px.y()));
+  const int x = static_cast<int>(roundHalfAwayFromZero(px.x())), y = static_cast<int>(roundHalfAwayFromZero(px.y()));
   const int x0 = std::max(0, x - r), x1 = std::min(depth_raw.cols - 1, x + r);
   const int y0 = std::max(0, y - r), y1 = std::min(depth_raw.rows - 1, y + r);
   int lo = 1 << 20, hi = 0;

@@ -6,6 +6,8 @@
 
 #include <opencv2/core/hal/intrin.hpp>
 
+#include "pipeline/frontend/round_half_away.h"
+
 // The x86 path: SSSE3's pmaddubsw for orientationDeg(), chosen at run time on x86-64 (the baseline
 // is SSE2), and cmp + adc in describe(). Elsewhere (aarch64: NEON) the portable path alone.
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -144,7 +146,7 @@ OrbDescriber::OrbDescriber(int stride) : stride_(stride) {
 }
 
 int OrbDescriber::angleBin(float angle_deg) {
-  int bin = static_cast<int>(std::lround(angle_deg * (kAngleBins / 360.0f)));
+  int bin = static_cast<int>(roundHalfAwayFromZero(angle_deg * (kAngleBins / 360.0f)));
   if (bin >= kAngleBins) bin -= kAngleBins;
   if (bin < 0) bin += kAngleBins;
   return bin;

@@ -1,5 +1,8 @@
 #include "solver/noise_model.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 namespace plumb {
@@ -11,6 +14,22 @@ TEST(NoiseModel, PixelSigmaGrowsWithThePyramidLevel) {
   const NoiseModelOptions options;
   EXPECT_DOUBLE_EQ(pixelSigma(options, 0), 1.0);
   EXPECT_NEAR(pixelSigma(options, 3), 1.2 * 1.2 * 1.2, 1e-15);
+}
+
+// The default scale factor's powers are tabulated (issue 22); the table must give std::pow's bits,
+// and any other scale factor, level beyond the table or negative level the formula's.
+TEST(NoiseModel, PixelSigmaEqualsTheFormulaBitForBit) {
+  for (const double scale : {1.2, 1.25, 2.0, 1.2000000000000002}) {
+    for (const double level0 : {1.0, 0.7}) {
+      NoiseModelOptions options;
+      options.scale_factor = scale;
+      options.pixel_sigma_level0 = level0;
+      for (int level = -2; level < 40; ++level) {
+        const double expected = level0 * std::pow(scale, std::max(level, 0));
+        EXPECT_EQ(pixelSigma(options, level), expected) << "scale " << scale << " level " << level;
+      }
+    }
+  }
 }
 
 TEST(NoiseModel, DepthSigmaIsQuadraticWithAFloor) {
