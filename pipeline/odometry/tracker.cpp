@@ -99,7 +99,7 @@ TrackResult Tracker::track(const FrameFeatures& input, uint64_t sequence, double
                            KeyframeRequest* request) {
   const FrameFeatures* features = &input;
   if (camera_.rolling_shutter_readout_s > 0 && has_velocity_ && velocity_dt_s_ > 0) {
-    compensated_frame_[0] = input;
+    compensated_frame_[0].copyFrom(input);  // the used entries only, not all ~290 kB of capacity
     compensateRollingShutter(camera_, camera_.rolling_shutter_readout_s,
                              logSE3(velocity_cur_last_) / velocity_dt_s_, &compensated_frame_[0]);
     features = &compensated_frame_[0];
@@ -262,7 +262,7 @@ void Tracker::fillNewMapRequest(const FrameFeatures& frame, uint64_t sequence, d
   request->twist_per_s.setZero();
   request->T_world_cam = T_world_cam;
   request->local_map_version = 0;
-  request->features = frame;
+  request->features.copyFrom(frame);  // the used entries only (a keyframe's copy, ~290 kB of capacity)
   for (std::size_t k = 0; k < frame.keypoints.size(); ++k) request->keypoint_landmark[k] = LandmarkRef{};
   for (std::size_t k = 0; k < frame.lines.size(); ++k) request->line_landmark[k] = LandmarkRef{};
   request->point_visibility.clear();
