@@ -75,7 +75,8 @@ int LocalBundleAdjuster::addObservation(int keyframe, int landmark, ObservationK
                                         const Eigen::Vector3d& z, const Eigen::Matrix3d& information) {
   if (num_observations_ >= static_cast<int>(observations_.size())) return -1;
   if (keyframe < 0 || keyframe >= num_keyframes_ || landmark < 0 || landmark >= num_landmarks_) return -1;
-  // (would poison the whole solve; allFiniteValues: the same test in fewer instructions)
+  // Non-finite input would poison the whole solve: z.allFinite() && information.allFinite(), as
+  // one test of the two residues' sum (finite_check.h; +0 only when every entry is finite).
   if (!(finiteResidue(z.data(), 3) + finiteResidue(information.data(), 9) == 0.0)) return -1;
   Observation& obs = observations_[num_observations_];
   obs.keyframe = keyframe;

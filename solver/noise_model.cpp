@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdint>
-#include <cstring>
 
 namespace plumb {
 
@@ -22,19 +20,13 @@ struct DefaultScalePowers {
   }
 };
 
-bool sameBits(double a, double b) {
-  uint64_t x = 0, y = 0;
-  std::memcpy(&x, &a, sizeof x);
-  std::memcpy(&y, &b, sizeof y);
-  return x == y;
-}
-
 }  // namespace
 
 double pixelSigma(const NoiseModelOptions& options, int pyramid_level) {
   const int level = std::max(pyramid_level, 0);
   static const DefaultScalePowers kDefault;
-  if (level < kTabulatedLevels && sameBits(options.scale_factor, kDefault.scale_factor)) {
+  // Equal values are equal bits here: the default (1.2) is neither zero nor NaN.
+  if (level < kTabulatedLevels && options.scale_factor == kDefault.scale_factor) {
     return options.pixel_sigma_level0 * kDefault.power[std::size_t(level)];
   }
   return options.pixel_sigma_level0 * std::pow(options.scale_factor, level);

@@ -1,8 +1,9 @@
 #pragma once
 // std::lround for floats, inline. libm's lroundf is a call of ~27 instructions and the front end
 // rounds ~4,300 coordinates and angles a frame with it (issue 22's instruction budget); this is
-// ~8 and returns the same value for every float (the tests compare it with std::lround over every
-// float of magnitude below 2^24 and at the edges).
+// ~8 and returns the same value for every float (tests/pipeline/frontend/round_half_away_test.cpp
+// compares it with std::lround next to every integer and half up to 2^16, sparser to 2^31, on a
+// sweep of all magnitudes and at the edges).
 #include <cmath>
 
 namespace plumb {
