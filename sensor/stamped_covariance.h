@@ -31,6 +31,12 @@ struct StampedTrackedCovariance {
   Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();        // in the world
   Eigen::Matrix<double, 6, 6> covariance_local = Eigen::Matrix<double, 6, 6>::Zero();  // to the map
+  // Optional: the previous frame's pose in this frame's map (TrackResult::T_world_previous), from
+  // which MAVLink's velocity is made; a file without it (older plumb) gives the published poses'
+  // difference.
+  bool has_previous = false;
+  double previous_timestamp = 0;
+  Eigen::Isometry3d T_world_previous = Eigen::Isometry3d::Identity();
 };
 
 }  // namespace plumb

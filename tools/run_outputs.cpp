@@ -86,6 +86,9 @@ void RunOutputs::onPose(const FrameOutput& out) {
   // The estimate jumps at a new map segment, a relocalization and a loop correction: the
   // autopilot must know (docs/LOOP.md "What the robot receives").
   sample.reset = out.new_map || out.relocalized || out.loop_corrected;
+  sample.has_previous_in_map = out.has_pose && out.track.has_previous;
+  sample.previous_timestamp_s = out.track.previous_timestamp_s;
+  sample.T_world_previous_cam = out.track.T_world_previous;
   mavlink_->publish(sample);
 }
 

@@ -91,13 +91,19 @@ void MavlinkOdometrySink::buildOdometry(const OdometrySample& sample, MavlinkOdo
   m.q[3] = static_cast<float>(q.z());
 
   // Linear and angular velocity of the body, in the body frame (child_frame_id BODY_FRD), from
-  // the previous published pose. Unknown (NaN) on the first pose and after a reset or a gap.
+  // the previous frame: as the current map places it when the sample says (no map update in the
+  // velocity), else the previous published pose. Unknown (NaN) on the first pose and after a
+  // reset or a gap.
   const double dt = sample.timestamp_s - previous_time_s_;
   const bool have_velocity = has_previous_ && dt > 1e-6;
+  const bool previous_in_map = sample.has_previous_in_map && sample.previous_timestamp_s == previous_time_s_;
+  const Eigen::Isometry3d T_world_previous_cam = previous_in_map ? sample.T_world_previous_cam : previous_T_world_cam_;
   if (have_velocity) {
+    const Eigen::Isometry3d T_local_previous_body =
+        previous_in_map ? localBodyPose(sample.T_world_previous_cam, frames_) : previous_T_local_body_;
     const Eigen::Matrix3d& R = T_local_body.linear();
-    const Eigen::Vector3d v_body = R.transpose() * (p - previous_T_local_body_.translation()) / dt;
-    const Eigen::Vector3d w_body = logSO3(previous_T_local_body_.linear().transpose() * R) / dt;
+    const Eigen::Vector3d v_body = R.transpose() * (p - T_local_previous_body.translation()) / dt;
+    const Eigen::Vector3d w_body = logSO3(T_local_previous_body.linear().transpose() * R) / dt;
     m.vx = static_cast<float>(v_body.x());
     m.vy = static_cast<float>(v_body.y());
     m.vz = static_cast<float>(v_body.z());
@@ -123,7 +129,7 @@ void MavlinkOdometrySink::buildOdometry(const OdometrySample& sample, MavlinkOdo
   m.velocity_covariance[0] = kNaN;
   if (have_velocity && previous_has_local_covariance_ && sample.has_local_covariance) {
     const Matrix6d covariance =
-        mavlinkVelocityCovariance(previous_local_covariance_, sample.local_covariance, previous_T_world_cam_,
+        mavlinkVelocityCovariance(previous_local_covariance_, sample.local_covariance, T_world_previous_cam,
                                   sample.T_world_cam, dt, frames_);
     if (covariance.allFinite()) upperTriangle21(covariance, m.velocity_covariance);
   }

@@ -63,6 +63,13 @@ struct OdometrySample {
   bool has_local_covariance = false;
   Matrix6d local_covariance = Matrix6d::Zero();
   bool reset = false;  // the estimate jumped (new map segment, loop correction): reset_counter++
+  // The previous frame's pose in the map this one was tracked in (TrackResult::T_world_previous):
+  // when set and it is the previous sample's frame (same timestamp), the velocity is the motion
+  // from it, so a map update between the two frames (local BA, a loop) is not sent as velocity.
+  // Unset: the velocity is the difference of the two published poses.
+  bool has_previous_in_map = false;
+  double previous_timestamp_s = 0.0;
+  Eigen::Isometry3d T_world_previous_cam = Eigen::Isometry3d::Identity();
 };
 
 struct MavlinkStats {

@@ -39,7 +39,9 @@ Status CovarianceWriter::open(const std::string& path, CovarianceFileKind kind) 
     std::fprintf(file_.file(),
                  "%s: timestamp tx ty tz qx qy qz qw (T_world_cam as tracked), then the 21\n"
                  "# upper-triangle entries of the 6x6 covariance of the left perturbation [rho(3) phi(3)] of\n"
-                 "# T_cam_world with respect to the world frame, then 21 of it relative to the map\n",
+                 "# T_cam_world with respect to the world frame, then 21 of it relative to the map; optionally\n"
+                 "# then the previous frame's timestamp and its pose in this frame's map (tx ty tz qx qy qz qw),\n"
+                 "# from which MAVLink's velocity is made\n",
                  kTrackedHeader);
   }
   return Status::Ok();
@@ -74,6 +76,10 @@ Status CovarianceWriter::append(const StampedTrackedCovariance& f) {
   printPose(out, f.T_world_cam);
   printUpper(out, f.covariance);
   printUpper(out, f.covariance_local);
+  if (f.has_previous) {
+    std::fprintf(out, " %.6f", f.previous_timestamp);
+    printPose(out, f.T_world_previous);
+  }
   std::fprintf(out, "\n");
   return Status::Ok();
 }

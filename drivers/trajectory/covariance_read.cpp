@@ -81,12 +81,19 @@ Status readCovarianceFile(const std::string& path, CovarianceFile* out) {
     }
     const std::size_t n = line.tokens.size();
     if (tracked) {
-      if (n != 50) return Status::Error(where + ": expected 50 fields (timestamp, pose, 2 x 21 covariance entries), got " + std::to_string(n));
+      if (n != 50 && n != 58) {
+        return Status::Error(where + ": expected 50 fields (timestamp, pose, 2 x 21 covariance entries) or 58 (and the previous frame's timestamp and pose), got " + std::to_string(n));
+      }
       StampedTrackedCovariance f;
       PLUMB_RETURN_IF_ERROR(parseNumbers(where, line, 0, 1, &f.timestamp));
       PLUMB_RETURN_IF_ERROR(parsePose(where, line, 1, &f.T_world_cam));
       PLUMB_RETURN_IF_ERROR(parseUpper(where, line, 8, "the world covariance", &f.covariance));
       PLUMB_RETURN_IF_ERROR(parseUpper(where, line, 29, "the local covariance", &f.covariance_local));
+      if (n == 58) {
+        PLUMB_RETURN_IF_ERROR(parseNumbers(where, line, 50, 1, &f.previous_timestamp));
+        PLUMB_RETURN_IF_ERROR(parsePose(where, line, 51, &f.T_world_previous));
+        f.has_previous = true;
+      }
       f.valid = true;
       out->frames.push_back(f);
       continue;

@@ -127,7 +127,11 @@ Status evaluateNees(const std::vector<StampedPose>& gt, const CovarianceFile& fi
       world.add(logSE3(f.T_world_cam.inverse() * G_est_world), f.covariance);
     }
     if (have_truth && previous != nullptr && f.timestamp - previous->timestamp <= options.max_frame_gap_s) {
-      const Eigen::Isometry3d T_i = previous->T_world_cam.inverse(), T_j = f.T_world_cam.inverse();
+      // The previous frame as this frame's map places it when the file has it (what MAVLink's
+      // velocity is made from: no map update between the two frames in the motion).
+      const bool in_map = f.has_previous && std::abs(f.previous_timestamp - previous->timestamp) < 1e-6;
+      const Eigen::Isometry3d T_i = (in_map ? f.T_world_previous : previous->T_world_cam).inverse();
+      const Eigen::Isometry3d T_j = f.T_world_cam.inverse();
       const Matrix6d C = relativePoseCovariance(T_i, T_j, previous->covariance_local, f.covariance_local, Matrix6d::Zero());
       motion.add(relativePoseError(G_previous.inverse() * G, T_i * T_j.inverse()), C);
     }

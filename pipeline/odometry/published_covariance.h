@@ -27,6 +27,9 @@ inline StampedTrackedCovariance toStampedTrackedCovariance(const FrameOutput& ou
   c.T_world_cam = out.T_world_cam;
   c.covariance = out.track.covariance;
   c.covariance_local = out.track.covariance_local;
+  c.has_previous = out.track.has_previous;
+  c.previous_timestamp = out.track.previous_timestamp_s;
+  c.T_world_previous = out.track.T_world_previous;
   return c;
 }
 

@@ -174,6 +174,10 @@ TrackResult Tracker::track(const FrameFeatures& input, uint64_t sequence, double
     if (a.valid && a.local_index >= 0) ++b_->line_found[a.local_index];
   }
 
+  // T_world_last_ followed every map change since the last frame (followMapCorrections).
+  result.has_previous = std::isfinite(last_timestamp_s_);
+  result.previous_timestamp_s = last_timestamp_s_;
+  result.T_world_previous = T_world_last_;
   velocity_cur_last_ = T_cam_world * T_world_last_;
   velocity_dt_s_ = timestamp_s - last_timestamp_s_;
   has_velocity_ = true;

@@ -37,6 +37,15 @@ struct TrackResult {
   bool covariance_valid = false;
   Eigen::Matrix<double, 6, 6> covariance_local = Eigen::Matrix<double, 6, 6>::Zero();
   bool covariance_local_valid = false;
+  // The previous tracked frame's pose as the map THIS frame was tracked in places it: the tracker
+  // moves its last frame with its reference keyframe when local BA or a loop correction changes
+  // the map between two frames. The frame-to-frame motion T_world_previous^-1 T_world_cam is
+  // then free of that change, where the difference of two published poses is not (a keyframe's
+  // BA moved synth:office_loop's next pose by up to 27 mm: a 0.8 m/s spike in a velocity made
+  // from published poses). What MAVLink's velocity is made from (docs/MAVLINK.md).
+  bool has_previous = false;
+  double previous_timestamp_s = 0.0;
+  Eigen::Isometry3d T_world_previous = Eigen::Isometry3d::Identity();
 };
 
 }  // namespace plumb

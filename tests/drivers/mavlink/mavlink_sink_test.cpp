@@ -194,6 +194,48 @@ TEST(MavlinkSink, VelocityCovarianceFromConsecutiveLocalCovariances) {
   EXPECT_TRUE(std::isnan(m.velocity_covariance[0]));
 }
 
+// Local BA or a loop moves the map between two frames: the second pose is published in the moved
+// map, the first was not. The velocity is the motion from the previous frame as the moved map
+// places it (OdometrySample::T_world_previous_cam), so the map's move is not sent as velocity;
+// a sample without it, or naming another frame, gives the published poses' difference.
+TEST(MavlinkSink, AMapUpdateBetweenTwoFramesIsNotSentAsVelocity) {
+  UdpReceiver rx;
+  MavlinkOdometrySink sink;
+  ASSERT_TRUE(sink.open(udpOptions(rx.port)).ok());
+  auto velocity = [](const MavlinkOdometry& m) {
+    return Vector6d((Vector6d() << m.vx, m.vy, m.vz, m.rollspeed, m.pitchspeed, m.yawspeed).finished());
+  };
+  const OdometrySample s0 = sampleAt(0), s1 = sampleAt(1);
+  MavlinkOdometry m;
+  sink.buildOdometry(s0, &m);
+  sink.buildOdometry(s1, &m);
+  const Vector6d no_update = velocity(m);  // the true motion: no map change between the frames
+  ASSERT_TRUE(no_update.allFinite());
+
+  // 27 mm and 0.5 deg: what one keyframe's BA moved synth:office_loop's next pose by.
+  const Eigen::Isometry3d C = Eigen::Translation3d(0.02, -0.015, 0.01) *
+                              Eigen::AngleAxisd(0.5 * M_PI / 180, Eigen::Vector3d(0.3, 1, 0.2).normalized());
+  OdometrySample moved = s1;
+  moved.T_world_cam = C * s1.T_world_cam;
+  for (int variant = 0; variant < 3; ++variant) {
+    MavlinkOdometrySink fresh;
+    ASSERT_TRUE(fresh.open(udpOptions(rx.port)).ok());
+    OdometrySample s = moved;
+    s.has_previous_in_map = variant != 1;
+    s.previous_timestamp_s = variant == 2 ? s0.timestamp_s - 1.0 / 30 : s0.timestamp_s;  // 2: another frame
+    s.T_world_previous_cam = C * s0.T_world_cam;
+    fresh.buildOdometry(s0, &m);
+    fresh.buildOdometry(s, &m);
+    const Vector6d v = velocity(m);
+    if (variant == 0) {
+      EXPECT_LT((v - no_update).norm(), 1e-4 * no_update.norm()) << v.transpose() << " vs " << no_update.transpose();
+    } else {
+      // The published difference carries the map's move: ~1 m/s over one frame at 30 Hz.
+      EXPECT_GT((v.head<3>() - no_update.head<3>()).norm(), 0.5) << "variant " << variant;
+    }
+  }
+}
+
 TEST(MavlinkSink, UdpRoundTripDecodesToFrameChangedPose) {
   UdpReceiver rx;
   MavlinkOdometrySink sink;

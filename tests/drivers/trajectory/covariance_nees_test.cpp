@@ -86,16 +86,27 @@ TEST(CovarianceFiles, RoundTripBothKindsAndMarkers) {
   f.covariance_local = someCovariance(0.002, 0.001);
   StampedTrackedCovariance g;
   g.timestamp = 20.1;
+  StampedTrackedCovariance h = f;  // with the previous frame's pose in its map
+  h.timestamp = 20.2;
+  h.has_previous = true;
+  h.previous_timestamp = 20.0;
+  h.T_world_previous = Eigen::Translation3d(0.5, 0.25, -1) * Eigen::AngleAxisd(-0.3, Eigen::Vector3d::UnitX());
   ASSERT_TRUE(writer.open(dir.file("tracked.txt"), CovarianceFileKind::kTracked).ok());
   ASSERT_TRUE(writer.append(f).ok());
   ASSERT_TRUE(writer.append(g).ok());
+  ASSERT_TRUE(writer.append(h).ok());
   EXPECT_FALSE(writer.append(a).ok());  // a keyframe line into a tracked file
   ASSERT_TRUE(writer.close().ok());
   ASSERT_TRUE(readCovarianceFile(dir.file("tracked.txt"), &file).ok());
   ASSERT_EQ(file.kind, CovarianceFileKind::kTracked);
-  ASSERT_EQ(file.frames.size(), 2u);
+  ASSERT_EQ(file.frames.size(), 3u);
   EXPECT_TRUE(file.frames[0].valid);
+  EXPECT_FALSE(file.frames[0].has_previous);
   EXPECT_FALSE(file.frames[1].valid);
+  EXPECT_TRUE(file.frames[2].valid);
+  EXPECT_TRUE(file.frames[2].has_previous);
+  EXPECT_NEAR(file.frames[2].previous_timestamp, 20.0, 1e-9);
+  EXPECT_LT((file.frames[2].T_world_previous.matrix() - h.T_world_previous.matrix()).norm(), 1e-8);
   EXPECT_LT((file.frames[0].covariance_local - f.covariance_local).norm(), 1e-8 * f.covariance_local.norm());
 }
 
@@ -194,6 +205,34 @@ TEST(Nees, ErrorsDrawnFromTheirCovariancesGiveOnePerDof) {
   EXPECT_NEAR(r.keyframe_relative.mean_per_dof, 4.0, 0.35);
   EXPECT_LT(r.keyframe_relative.inside_95, 0.6);
   EXPECT_NEAR(r.frame_motion.mean_per_dof, 4.0, 0.4);
+}
+
+// The map moves between two frames now and then (local BA after a keyframe, a loop): every later
+// published pose jumps with it. The frame motion is graded from the previous frame as this
+// frame's map places it (what MAVLink's velocity is made from), so it still gives ~1 per dof;
+// without that pose in the file the difference of the published poses carries the jumps.
+TEST(Nees, FrameMotionFromThePreviousPoseInTheFramesMap) {
+  const std::vector<StampedPose> gt = groundTruth(60.0);
+  const Drawn d = drawFromCovariances(gt, Eigen::Isometry3d::Identity(), 1.0, 2);
+  CovarianceFile jumped = d.file;
+  Eigen::Isometry3d map_move = Eigen::Isometry3d::Identity();
+  for (std::size_t i = 1; i < jumped.frames.size(); ++i) {
+    StampedTrackedCovariance& f = jumped.frames[i];
+    if (i % 10 == 0) {  // 2 cm and 0.3 deg, far beyond the frames' millimetre sigmas
+      map_move = Eigen::Translation3d(0.02, 0, -0.01) * Eigen::AngleAxisd(0.005, Eigen::Vector3d::UnitY()) * map_move;
+    }
+    f.has_previous = true;
+    f.previous_timestamp = d.file.frames[i - 1].timestamp;
+    f.T_world_previous = map_move * d.file.frames[i - 1].T_world_cam;
+    f.T_world_cam = map_move * f.T_world_cam;
+  }
+  NeesResult with, without;
+  ASSERT_TRUE(evaluateNees(gt, jumped, d.anchor, NeesOptions{}, &with).ok());
+  EXPECT_NEAR(with.frame_motion.mean_per_dof, 1.0, 0.1);
+  for (StampedTrackedCovariance& f : jumped.frames) f.has_previous = false;
+  ASSERT_TRUE(evaluateNees(gt, jumped, d.anchor, NeesOptions{}, &without).ok());
+  EXPECT_GT(without.frame_motion.mean_per_dof, 5.0);
+  EXPECT_EQ(with.frame_motion.count, without.frame_motion.count);
 }
 
 }  // namespace
