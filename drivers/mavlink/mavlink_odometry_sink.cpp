@@ -97,10 +97,9 @@ void MavlinkOdometrySink::buildOdometry(const OdometrySample& sample, MavlinkOdo
   const double dt = sample.timestamp_s - previous_time_s_;
   const bool have_velocity = has_previous_ && dt > 1e-6;
   const bool previous_in_map = sample.has_previous_in_map && sample.previous_timestamp_s == previous_time_s_;
-  const Eigen::Isometry3d T_world_previous_cam = previous_in_map ? sample.T_world_previous_cam : previous_T_world_cam_;
+  const Eigen::Isometry3d& T_world_previous_cam = previous_in_map ? sample.T_world_previous_cam : previous_T_world_cam_;
   if (have_velocity) {
-    const Eigen::Isometry3d T_local_previous_body =
-        previous_in_map ? localBodyPose(sample.T_world_previous_cam, frames_) : previous_T_local_body_;
+    const Eigen::Isometry3d T_local_previous_body = localBodyPose(T_world_previous_cam, frames_);
     const Eigen::Matrix3d& R = T_local_body.linear();
     const Eigen::Vector3d v_body = R.transpose() * (p - T_local_previous_body.translation()) / dt;
     const Eigen::Vector3d w_body = logSO3(T_local_previous_body.linear().transpose() * R) / dt;
@@ -114,7 +113,6 @@ void MavlinkOdometrySink::buildOdometry(const OdometrySample& sample, MavlinkOdo
     m.vx = m.vy = m.vz = kNaN;
     m.rollspeed = m.pitchspeed = m.yawspeed = kNaN;
   }
-  previous_T_local_body_ = T_local_body;
   previous_time_s_ = sample.timestamp_s;
   has_previous_ = true;
 

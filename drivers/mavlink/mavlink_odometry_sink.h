@@ -116,7 +116,6 @@ class MavlinkOdometrySink {
   int64_t next_heartbeat_ns_ = 0;
   bool has_previous_ = false;
   double previous_time_s_ = 0.0;
-  Eigen::Isometry3d previous_T_local_body_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d previous_T_world_cam_ = Eigen::Isometry3d::Identity();
   bool previous_has_local_covariance_ = false;
   Matrix6d previous_local_covariance_ = Matrix6d::Zero();
