@@ -34,18 +34,30 @@ command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 cmake -S fuzz -B build-fuzz -DCMAKE_CXX_COMPILER="$CXX_FUZZ" "${launcher[@]}" >/dev/null || exit 1
 cmake --build build-fuzz -j "$JOBS" --target "${TARGETS[@]/#/fuzz_}" >/dev/null || exit 1
 
-failed=0
-printf '%-18s %12s %8s %7s %7s %7s  %s\n' target executions exec/s cov ft corpus result
-for t in "${TARGETS[@]}"; do
-  work="$probe/$t"
+# The targets run $JOBS at a time (each fuzzer is one process on one core; with FUZZ_SEED a target
+# sees the same inputs whichever runs beside it), and are reported in the order above.
+run_target() {
+  local t=$1 work="$probe/$1"
   mkdir -p "$work/corpus" "build-fuzz/artifacts/$t"
   cp fuzz/corpus/"$t"/* "$work/corpus/"
-  extra=()  # dictionary, seed
+  local extra=()  # dictionary, seed
   [ -f "fuzz/dict/$t.dict" ] && extra=(-dict="fuzz/dict/$t.dict")
   [ -n "${FUZZ_SEED:-}" ] && extra+=(-seed="$FUZZ_SEED")
   ./build-fuzz/fuzz_"$t" -max_total_time="$SECONDS_PER_TARGET" -print_final_stats=1 -timeout=10 \
     "${extra[@]}" -artifact_prefix="build-fuzz/artifacts/$t/" "$work/corpus" >"$work/log" 2>&1
-  rc=$?
+  echo $? >"$work/rc"
+}
+for t in "${TARGETS[@]}"; do
+  while [ "$(jobs -rp | wc -l)" -ge "$JOBS" ]; do wait -n || true; done
+  run_target "$t" &
+done
+wait
+failed=0
+printf '%-18s %12s %8s %7s %7s %7s  %s\n' target executions exec/s cov ft corpus result
+for t in "${TARGETS[@]}"; do
+  work="$probe/$t"
+  rc=1
+  [ -f "$work/rc" ] && rc=$(cat "$work/rc")
   # The last status line ("#N DONE cov: C ft: F corp: K/B ...") holds the final coverage.
   status=$(grep -E '^#[0-9]+' "$work/log" | tail -1)
   cov=$(sed -n 's/.* cov: \([0-9]*\).*/\1/p' <<<"$status")
@@ -55,13 +67,13 @@ for t in "${TARGETS[@]}"; do
   rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$work/log")
   [ -z "$execs" ] && execs=$(sed -n 's/^#\([0-9]*\).*/\1/p' <<<"$status")
   result=ok
-  if [ $rc -ne 0 ]; then
+  if [ "$rc" -ne 0 ]; then
     failed=1
     crash=$(ls -t "build-fuzz/artifacts/$t/" 2>/dev/null | head -1)
     result="CRASH (rc $rc) build-fuzz/artifacts/$t/$crash"
   fi
   printf '%-18s %12s %8s %7s %7s %7s  %s\n' "$t" "${execs:-?}" "${rate:-?}" "${cov:-?}" "${ft:-?}" "${corp:-?}" "$result"
-  if [ $rc -ne 0 ]; then
+  if [ "$rc" -ne 0 ]; then
     grep -E 'INVARIANT|ERROR:|SUMMARY|runtime error|==[0-9]+==' "$work/log" | head -8 | sed 's/^/    /'
   fi
 done

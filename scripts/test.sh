@@ -9,7 +9,8 @@
 #   5. clang-tidy (bugprone + naming, warnings as errors) on the leaf product folders platform/,
 #      runtime/, solver/, sensor/ (~2 min; scripts/tidy.sh with no folder argument checks every
 #      product folder, ~10 min on 2 cores: too much of CI's budget, run it before a merge);
-#   6. the aarch64 cross build and its unit tests under qemu (scripts/cross_aarch64.sh).
+#   6. the aarch64 cross build and its unit tests under qemu (scripts/cross_aarch64.sh; not the
+#      system, hostile and tools labels, which start the whole tool: docs/EMBEDDED.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 JOBS=$(nproc 2>/dev/null || echo 2)

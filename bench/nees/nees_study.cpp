@@ -3,7 +3,7 @@
 //
 //   plumb_nees_study [--preset textured] [--seeds 50] [--first-seed 1] [--frames 150] [--no-lines]
 //                    [--map-error | --no-map-error] [--no-variance-factor] [--pooled-variance-factor]
-//                    [--relative-scale S] [--tracked-scale S]
+//                    [--relative-scale S] [--tracked-scale S] [--motion-scale S]
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -38,6 +38,7 @@ int main(int argc, char** argv) {
     else if (a == "--pooled-variance-factor") system_options.odometry.uncertainty.variance_components = false;
     else if (a == "--relative-scale" && has_value) system_options.odometry.uncertainty.relative_scale = std::atof(argv[++i]);
     else if (a == "--tracked-scale" && has_value) system_options.odometry.uncertainty.tracked_scale = std::atof(argv[++i]);
+    else if (a == "--motion-scale" && has_value) system_options.odometry.uncertainty.motion_scale = std::atof(argv[++i]);
     else {
       std::fprintf(stderr, "plumb_nees_study: unknown or incomplete option %s\n", a.c_str());
       return 2;

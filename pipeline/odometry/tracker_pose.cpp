@@ -124,16 +124,21 @@ void Tracker::publishCovariance(const PoseResult& pose, const Vector6d& twist_pe
   result->covariance_valid = false;
   if (!pose.covariance_valid) return;
   const double variance_factor = varianceFactor(pose.inlier_chi2, 6.0, pose_options_.chi2);
-  result->covariance_local = inflateTrackedCovariance(options_.uncertainty, pose.covariance, variance_factor) +
-                             timingCovariance(options_.uncertainty, camera_.rolling_shutter_readout_s, twist_per_s) +
-                             rollingShutterCovariance(options_.uncertainty, camera_.rolling_shutter_readout_s,
-                                                      options_.uncertainty.rolling_shutter_frame_share);
-  // The map is held exact by pose-only optimisation: covariance_local is the frame relative to
-  // it (what two consecutive frames do not share: the velocity's). Relative to the reference
-  // keyframe, whose world covariance it chains with, the frame also carries the landmarks' own
-  // position errors (PoseResult::map_covariance), which consecutive frames share.
+  const Matrix6d model_terms =
+      timingCovariance(options_.uncertainty, camera_.rolling_shutter_readout_s, twist_per_s) +
+      rollingShutterCovariance(options_.uncertainty, camera_.rolling_shutter_readout_s,
+                               options_.uncertainty.rolling_shutter_frame_share);
+  // covariance_local: what two consecutive frames do not share, the velocity's. The map is held
+  // exact by pose-only optimisation, and the detection offsets that persist from frame to frame
+  // (what tracked_scale inflates for) cancel in the difference too: motion_scale.
+  result->covariance_local =
+      inflateMotionCovariance(options_.uncertainty, pose.covariance, variance_factor) + model_terms;
+  // Relative to the reference keyframe, whose world covariance it chains with, the frame carries
+  // the persistent errors (tracked_scale) and the landmarks' own position errors
+  // (PoseResult::map_covariance), which consecutive frames share.
   if (!local_map_->reference_world_covariance_valid) return;
-  Matrix6d relative_to_reference = result->covariance_local;
+  Matrix6d relative_to_reference =
+      inflateTrackedCovariance(options_.uncertainty, pose.covariance, variance_factor) + model_terms;
   if (options_.uncertainty.tracked_map_error) {
     relative_to_reference += inflateTrackedCovariance(options_.uncertainty, pose.map_covariance, variance_factor);
   }

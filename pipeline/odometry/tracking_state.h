@@ -26,11 +26,13 @@ struct TrackResult {
   bool used_motion_fallback = false;  // constant velocity failed; wide / zero-motion retry used
   bool keyframe_requested = false;
   // Covariances of the tracked pose, 6x6 of the left perturbation [rho; phi] of T_cam_world
-  // (solver/se3.h), calibrated (docs/UNCERTAINTY.md). covariance_local: relative to the map, from
-  // the final pose-only optimisation (inverse of its robust Gauss-Newton information, inflated by
-  // UncertaintyOptions::tracked_*); what the frame-to-frame motion (MAVLink's velocity) builds on.
-  // covariance: with respect to the world frame, the reference keyframe's world covariance chained
-  // with covariance_local: what is published as the pose's (MAVLink, API, --track-covariance).
+  // (solver/se3.h), calibrated (docs/UNCERTAINTY.md). covariance_local: relative to the map, the
+  // part two consecutive frames do not share, from the final pose-only optimisation (inverse of its
+  // robust Gauss-Newton information, scaled by UncertaintyOptions::motion_scale); what the frame-to-
+  // frame motion (MAVLink's velocity) builds on. covariance: with respect to the world frame, the
+  // reference keyframe's world covariance chained with the frame's relative to it (pose-only scaled
+  // by tracked_scale, plus the map error): what is published as the pose's (MAVLink, API,
+  // --track-covariance).
   // Invalid when the optimisation did not run or was degenerate (or, for `covariance`, the
   // reference keyframe has no world covariance).
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();

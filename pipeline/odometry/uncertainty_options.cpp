@@ -15,9 +15,10 @@ std::string validate(const UncertaintyOptions& o) {
   for (double v : values) {
     if (!(std::isfinite(v) && v >= 0)) return "every sigma, floor and share must be finite and >= 0";
   }
-  if (!(o.relative_scale > 0 && o.tracked_scale > 0 && o.loop_scale > 0 && std::isfinite(o.relative_scale) &&
-        std::isfinite(o.tracked_scale) && std::isfinite(o.loop_scale)))
-    return "relative_scale, tracked_scale and loop_scale must be finite and > 0";
+  if (!(o.relative_scale > 0 && o.tracked_scale > 0 && o.loop_scale > 0 && o.motion_scale > 0 &&
+        std::isfinite(o.relative_scale) && std::isfinite(o.tracked_scale) && std::isfinite(o.loop_scale) &&
+        std::isfinite(o.motion_scale)))
+    return "relative_scale, tracked_scale, motion_scale and loop_scale must be finite and > 0";
   if (!(o.default_translation_sigma_m > 0 && o.default_rotation_sigma_rad > 0 && o.segment_translation_sigma_m > 0 &&
         o.segment_rotation_sigma_rad > 0))
     return "the default and segment sigmas must be > 0 (they are chained as covariances)";
@@ -56,6 +57,13 @@ Eigen::Matrix<double, 6, 6> inflateTrackedCovariance(const UncertaintyOptions& o
                                                      const Eigen::Matrix<double, 6, 6>& pose_only,
                                                      double variance_factor) {
   return inflate(o, o.tracked_scale, o.tracked_floor_translation_m, o.tracked_floor_rotation_rad, pose_only,
+                 variance_factor);
+}
+
+Eigen::Matrix<double, 6, 6> inflateMotionCovariance(const UncertaintyOptions& o,
+                                                    const Eigen::Matrix<double, 6, 6>& pose_only,
+                                                    double variance_factor) {
+  return inflate(o, o.motion_scale, o.tracked_floor_translation_m, o.tracked_floor_rotation_rad, pose_only,
                  variance_factor);
 }
 
