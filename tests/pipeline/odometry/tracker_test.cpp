@@ -72,6 +72,34 @@ TEST(Tracker, RecoversTheTruePoseOfTheNextFrameFromPoints) {
   EXPECT_TRUE(fx.tracker->lastPose().isApprox(r.T_world_cam, 1e-12));
 }
 
+// The velocity's per-frame covariance (covariance_local) takes motion_scale, the world covariance
+// tracked_scale (docs/UNCERTAINTY.md "The motion's own scale"): changing one leaves the other
+// unchanged. The synthetic camera is global shutter, so both are pure multiples of pose-only's.
+TEST(Tracker, MotionScaleScalesOnlyTheVelocitysCovariance) {
+  const test::Scene scene = test::makeScene(1, 300, 0, kStart);
+  const test::View first = test::observe(scene, kStart);
+  const test::View second = test::observe(scene, kStart * kStep);
+  auto trackWith = [&](double motion_scale, double tracked_scale) {
+    OdometryOptions options;
+    options.uncertainty.motion_scale = motion_scale;
+    options.uncertainty.tracked_scale = tracked_scale;
+    Fixture fx(options);
+    (void)fx.startMap(*first.features, 0, kStart);
+    return fx.tracker->track(*second.features, 1, 0.1, nullptr);
+  };
+  const TrackResult base = trackWith(1.0, 1.5);
+  const TrackResult motion = trackWith(2.0, 1.5);
+  const TrackResult tracked = trackWith(1.0, 3.0);
+  ASSERT_TRUE(base.covariance_local_valid && base.covariance_valid);
+  ASSERT_TRUE(motion.covariance_local_valid && motion.covariance_valid);
+  ASSERT_TRUE(tracked.covariance_local_valid && tracked.covariance_valid);
+  ASSERT_GT(base.covariance_local.trace(), 0.0);
+  EXPECT_TRUE(motion.covariance_local.isApprox(2.0 * base.covariance_local, 1e-12));
+  EXPECT_TRUE(motion.covariance.isApprox(base.covariance, 1e-12));
+  EXPECT_TRUE(tracked.covariance_local.isApprox(base.covariance_local, 1e-12));
+  EXPECT_FALSE(tracked.covariance.isApprox(base.covariance, 1e-3));
+}
+
 TEST(Tracker, FollowsASequenceWithConstantVelocity) {
   // Five frames of the same motion: from the second on the velocity prediction is exact, and the
   // per-frame poses stay on the true trajectory (no drift with exact data).
