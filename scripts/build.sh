@@ -5,6 +5,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 JOBS=$(nproc 2>/dev/null || echo 2)
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPLUMB_BUILD_TESTS=ON -DPLUMB_BUILD_BENCH=ON \
+source scripts/generator.sh
+plumb_generator_args build
+cmake -S . -B build "${generator_args[@]}" -DCMAKE_BUILD_TYPE=Release -DPLUMB_BUILD_TESTS=ON -DPLUMB_BUILD_BENCH=ON \
   -DPLUMB_PYTHON=ON "$@" >/dev/null
 cmake --build build -j "$JOBS"

@@ -125,7 +125,9 @@ if [ -n "$SKIP_LABELS" ] && echo system | grep -Eq "$SKIP_LABELS"; then
   SYSTEM_TESTS=OFF
 fi
 step "configure build-aarch64"
-cmake -S . -B build-aarch64 -DCMAKE_BUILD_TYPE=Release \
+source scripts/generator.sh
+plumb_generator_args build-aarch64
+cmake -S . -B build-aarch64 "${generator_args[@]}" -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_TOOLCHAIN_FILE="$PWD/cmake/toolchain-aarch64.cmake" -DPLUMB_ARM64_SYSROOT="$SYSROOT" \
   -DPLUMB_BUILD_BENCH=OFF -DPLUMB_BUILD_TESTS=ON -DPLUMB_SYSTEM_TESTS="$SYSTEM_TESTS" \
   -DPLUMB_TEST_COMPILE_OPTIONS=-O1 >/dev/null

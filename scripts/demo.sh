@@ -7,7 +7,9 @@ cd "$(dirname "$0")/.."
 start=$(date +%s)
 JOBS=$(nproc 2>/dev/null || echo 2)
 bash scripts/install_deps.sh
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPLUMB_BUILD_TESTS=OFF -DPLUMB_BUILD_BENCH=OFF \
+source scripts/generator.sh
+plumb_generator_args build
+cmake -S . -B build "${generator_args[@]}" -DCMAKE_BUILD_TYPE=Release -DPLUMB_BUILD_TESTS=OFF -DPLUMB_BUILD_BENCH=OFF \
   -DPLUMB_PYTHON=OFF >/dev/null
 cmake --build build -j "$JOBS" --target plumb
 built=$(date +%s)

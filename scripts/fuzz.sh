@@ -31,7 +31,9 @@ fi
 
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-cmake -S fuzz -B build-fuzz -DCMAKE_CXX_COMPILER="$CXX_FUZZ" "${launcher[@]}" >/dev/null || exit 1
+source scripts/generator.sh
+plumb_generator_args build-fuzz
+cmake -S fuzz -B build-fuzz "${generator_args[@]}" -DCMAKE_CXX_COMPILER="$CXX_FUZZ" "${launcher[@]}" >/dev/null || exit 1
 cmake --build build-fuzz -j "$JOBS" --target "${TARGETS[@]/#/fuzz_}" >/dev/null || exit 1
 
 # The targets run $JOBS at a time (each fuzzer is one process on one core; with FUZZ_SEED a target

@@ -16,7 +16,7 @@ done
 # libopencv-dev pulls VTK, GDAL, Qt, ... and was most of a 16-minute first run), image codecs and
 # the sensor libraries.
 PRODUCT_PACKAGES=(
-  build-essential cmake pkg-config
+  build-essential cmake pkg-config ninja-build  # ninja: scripts/generator.sh
   libeigen3-dev libopencv-core-dev libopencv-imgproc-dev libpng-dev libdeflate-dev
   libopenni2-dev libv4l-dev libusb-1.0-0-dev
   libjpeg62-turbo-dev  # MJPEG cameras and JPEG images in TUM folders (optional at build time)

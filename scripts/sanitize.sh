@@ -27,7 +27,9 @@ export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/scripts/lsan_suppressions.txt:print_suppressions=0}
 
 start=$(date +%s)
-cmake --preset "$PRESET" >/dev/null || exit 1
+source scripts/generator.sh
+plumb_generator_args "$BUILD_DIR"
+cmake --preset "$PRESET" "${generator_args[@]}" >/dev/null || exit 1
 targets=()
 for area in "${AREAS[@]}"; do
   targets+=("plumb_test_${area}")

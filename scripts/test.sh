@@ -26,7 +26,9 @@ ctest --test-dir build --output-on-failure -j "$JOBS" --timeout 900
 elapsed "Release ctest done"
 
 echo "== ThreadSanitizer: platform/ and runtime/ =="
-cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPLUMB_TSAN_ONLY=ON \
+source scripts/generator.sh
+plumb_generator_args build-tsan
+cmake -S . -B build-tsan "${generator_args[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPLUMB_TSAN_ONLY=ON \
   -DPLUMB_SANITIZE=thread >/dev/null
 cmake --build build-tsan -j "$JOBS"
 TSAN_OPTIONS="halt_on_error=1" ctest --test-dir build-tsan --output-on-failure -j "$JOBS" --timeout 600

@@ -6,8 +6,6 @@
 namespace plumb {
 namespace {
 
-// Below this angle [rad] the trigonometric coefficients lose digits; use their Taylor series.
-constexpr double kSmallAngle = 1e-4;
 
 // vee of the skew part of R: 2 sin(theta) * axis.
 Eigen::Vector3d skewVee(const Eigen::Matrix3d& R) {
@@ -29,7 +27,7 @@ Eigen::Matrix3d expSO3(const Eigen::Vector3d& phi) {
   const double theta = std::sqrt(theta2);
   double a;  // sin(theta) / theta
   double b;  // (1 - cos(theta)) / theta^2
-  if (theta < kSmallAngle) {
+  if (theta < kSmallRotationAngle) {
     a = 1.0 - theta2 / 6.0;
     b = 0.5 - theta2 / 24.0;
   } else {
@@ -45,7 +43,7 @@ Eigen::Vector3d logSO3(const Eigen::Matrix3d& R) {
   const Eigen::Vector3d w = skewVee(R);  // 2 sin(theta) axis
   const double sin_theta = 0.5 * w.norm();
   const double theta = std::atan2(sin_theta, cos_theta);
-  if (theta < kSmallAngle) {
+  if (theta < kSmallRotationAngle) {
     // theta / (2 sin theta) = 0.5 (1 + theta^2 / 6 + ...)
     return 0.5 * (1.0 + theta * theta / 6.0) * w;
   }
@@ -68,7 +66,7 @@ Eigen::Matrix3d leftJacobianSO3(const Eigen::Vector3d& phi) {
   const double theta = std::sqrt(theta2);
   double b;  // (1 - cos) / theta^2
   double c;  // (theta - sin) / theta^3
-  if (theta < kSmallAngle) {
+  if (theta < kSmallRotationAngle) {
     b = 0.5 - theta2 / 24.0;
     c = 1.0 / 6.0 - theta2 / 120.0;
   } else {
@@ -87,7 +85,7 @@ Eigen::Isometry3d expSE3(const Vector6d& rho_phi) {
   const double theta2 = phi.squaredNorm();
   const double theta = std::sqrt(theta2);
   double a, b, c;  // sin(theta) / theta, (1 - cos(theta)) / theta^2, (theta - sin(theta)) / theta^3
-  if (theta < kSmallAngle) {
+  if (theta < kSmallRotationAngle) {
     a = 1.0 - theta2 / 6.0;
     b = 0.5 - theta2 / 24.0;
     c = 1.0 / 6.0 - theta2 / 120.0;
@@ -113,7 +111,7 @@ Vector6d logSE3(const Eigen::Isometry3d& T) {
   // V^-1 = I - K/2 + d K^2 with d = 1/theta^2 - cot(theta/2) / (2 theta); the half-angle form
   // stays finite up to and including theta = pi.
   double d;
-  if (theta < kSmallAngle) {
+  if (theta < kSmallRotationAngle) {
     d = 1.0 / 12.0 + theta2 / 720.0;
   } else {
     const double half = 0.5 * theta;

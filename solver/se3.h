@@ -22,6 +22,13 @@
 
 namespace plumb {
 
+// Below this rotation angle [rad] the SO(3)/SE(3) coefficients lose digits and are taken from their
+// Taylor series (se3.cpp, se3_jacobians.cpp: one threshold, so the maps and their Jacobians switch
+// together).
+inline constexpr double kSmallRotationAngle = 1e-4;
+// Degrees per radian (180 / pi), for the angles tools print and grade.
+inline constexpr double kDegreesPerRadian = 57.29577951308232;
+
 // [v]x : the skew-symmetric matrix with hat(v) * w = v.cross(w).
 Eigen::Matrix3d hat(const Eigen::Vector3d& v);
 

@@ -9,8 +9,6 @@ namespace {
 
 // Below this angle [rad] the coefficients of Q are taken from their series (see the header).
 constexpr double kSeriesAngle = 1e-2;
-// Below this angle the SO(3) inverse coefficient uses its series (as logSE3 does).
-constexpr double kSmallAngle = 1e-4;
 
 // Barfoot's Q(rho, phi), the upper-right block of the SE(3) left Jacobian.
 Eigen::Matrix3d couplingQ(const Eigen::Vector3d& rho, const Eigen::Vector3d& phi) {
@@ -58,7 +56,7 @@ Eigen::Matrix3d leftJacobianInverseSO3(const Eigen::Vector3d& phi) {
   const double theta2 = phi.squaredNorm();
   const double theta = std::sqrt(theta2);
   double d;  // 1/theta^2 - cot(theta/2) / (2 theta), half-angle form finite up to pi
-  if (theta < kSmallAngle) {
+  if (theta < kSmallRotationAngle) {
     d = 1.0 / 12.0 + theta2 / 720.0;
   } else {
     const double half = 0.5 * theta;

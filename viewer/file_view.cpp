@@ -15,7 +15,7 @@
 namespace plumb::viewer {
 namespace {
 
-constexpr std::size_t kMaxTrajectoryPoints = 20000;  // a view is sent once: more detail than live
+constexpr std::size_t kMaxFileViewTrajectoryPoints = 20000;  // a view is sent once: more detail than live
 constexpr std::size_t kMaxMapPoints = 200000;
 constexpr Rgba kEstimateColor = kOutputColor;  // estimate poses without a ground-truth pair
 
@@ -47,7 +47,7 @@ void trajectoryStrips(const std::vector<StampedPose>& poses, const Eigen::Isomet
                       std::vector<LinePrimitive>* out, std::size_t* drawn) {
   std::size_t valid = 0;
   for (const StampedPose& p : poses) valid += p.valid;
-  const std::size_t step = valid > kMaxTrajectoryPoints ? (valid + kMaxTrajectoryPoints - 1) / kMaxTrajectoryPoints : 1;
+  const std::size_t step = valid > kMaxFileViewTrajectoryPoints ? (valid + kMaxFileViewTrajectoryPoints - 1) / kMaxFileViewTrajectoryPoints : 1;
   LinePrimitive strip;
   strip.color = color;
   strip.thickness_px = 4;

@@ -11,7 +11,7 @@
 namespace plumb::viewer {
 namespace {
 
-constexpr std::size_t kMaxTrajectoryPoints = 6000;  // per message: ~200 KB of JSON at most
+constexpr std::size_t kMaxLiveTrajectoryPoints = 6000;  // per message: ~200 KB of JSON at most
 constexpr std::size_t kMaxKeyframesDrawn = 400;     // the newest ones
 
 uint64_t toNs(double seconds) { return seconds > 0 ? uint64_t(std::llround(seconds * 1e9)) : 0; }
@@ -156,13 +156,13 @@ void LiveView::publishTrajectory() {
   trajectory_dirty_ = false;
   trajectory_sent_s_ = nowS();
   LineEntity output{"output", {}};
-  appendStrips(output_strips_, kOutputColor, 4, kMaxTrajectoryPoints, &output.lines);
+  appendStrips(output_strips_, kOutputColor, 4, kMaxLiveTrajectoryPoints, &output.lines);
   LineEntity tracked{"tracked", {}};
   std::vector<std::vector<Eigen::Vector3f>> tail(1);
   // The tail starts at the newest output pose, so the two lines join.
   if (!output_strips_.back().empty()) tail[0].push_back(output_strips_.back().back());
   for (const TrackPoint& p : tracked_tail_) tail[0].push_back(p.position);
-  appendStrips(tail, kTrackedColor, 4, kMaxTrajectoryPoints, &tracked.lines);
+  appendStrips(tail, kTrackedColor, 4, kMaxLiveTrajectoryPoints, &tracked.lines);
   server_.publish(kTrajectory, toNs(last_timestamp_s_), sceneUpdateJson(last_timestamp_s_, {output, tracked}));
 }
 

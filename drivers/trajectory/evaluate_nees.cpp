@@ -12,7 +12,6 @@ namespace plumb {
 namespace {
 
 constexpr double kChi2Dof6Quantile95 = 12.591587;
-constexpr double kRadToDeg = 57.29577951308232;
 
 // Per-sample terms collected for one quantity.
 struct Samples {
@@ -56,9 +55,9 @@ struct Samples {
     s.rotation_mean_per_dof = rotation / n / 3.0;
     s.inside_95 = double(inside) / n;
     s.rmse_translation_m = std::sqrt(e_t2 / n);
-    s.rmse_rotation_deg = std::sqrt(e_r2 / n) * kRadToDeg;
+    s.rmse_rotation_deg = std::sqrt(e_r2 / n) * kDegreesPerRadian;
     s.rms_sigma_translation_m = std::sqrt(sigma_t2 / n);
-    s.rms_sigma_rotation_deg = std::sqrt(sigma_r2 / n) * kRadToDeg;
+    s.rms_sigma_rotation_deg = std::sqrt(sigma_r2 / n) * kDegreesPerRadian;
     return s;
   }
 };

@@ -13,8 +13,6 @@ namespace plumb {
 
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
-
 Status numberArray(const runtime::JsonValue* v, std::size_t n, const std::string& what, double* out) {
   if (v == nullptr || v->type != runtime::JsonValue::Type::kArray || v->items.size() != n)
     return Status::Error(what + " must be an array of " + std::to_string(n) + " numbers");
@@ -66,7 +64,7 @@ Status readCandidate(const runtime::JsonValue& c, const std::string& where, Audi
 
 double viewAngleDeg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
   const double cosine = a.linear().col(2).dot(b.linear().col(2));
-  return std::acos(std::clamp(cosine, -1.0, 1.0)) * kRadToDeg;
+  return std::acos(std::clamp(cosine, -1.0, 1.0)) * kDegreesPerRadian;
 }
 
 }  // namespace
@@ -154,7 +152,7 @@ LoopGrading gradeLoops(const std::vector<StampedPose>& gt, const LoopAuditFile& 
       const Eigen::Isometry3d E = G_q.inverse() * G_c * c.T_candidate_query;
       const Vector6d e = logSE3(E);
       l.error_m = E.translation().norm();
-      l.error_deg = Eigen::AngleAxisd(E.linear()).angle() * kRadToDeg;
+      l.error_deg = Eigen::AngleAxisd(E.linear()).angle() * kDegreesPerRadian;
       const Eigen::LDLT<Matrix6d> ldlt(c.covariance);
       const double chi2 = ldlt.info() == Eigen::Success ? e.dot(ldlt.solve(e)) : INFINITY;
       l.error_sigmas = std::sqrt(std::max(0.0, chi2));

@@ -13,7 +13,7 @@ using testing::MixStage;
 using testing::ToyFrame;
 using testing::ToySource;
 
-constexpr int64_t kMs = 1'000'000;
+constexpr int64_t kSimulatedMs = 1'000'000;
 
 struct Simulated {
   std::vector<uint64_t> processed;  // frame indices that reached the last stage
@@ -60,57 +60,57 @@ TEST(RealtimeSimulation, ASlowStageDropsExactlyTheFramesThatFindNoFreeSlot) {
   //   f6 @60, f7 @70          -> drop, drop
   //   f8 @80 f3 back at 75    mix 100-125
   //   f9 @90 f5, f8           -> drop
-  const Simulated r = simulate(10, 10 * kMs, 2, 25 * kMs, 0);
+  const Simulated r = simulate(10, 10 * kSimulatedMs, 2, 25 * kSimulatedMs, 0);
   EXPECT_EQ(r.processed, (std::vector<uint64_t>{0, 1, 3, 5, 8}));
   EXPECT_EQ(r.dropped, (std::vector<uint64_t>{2, 4, 6, 7, 9}));
   EXPECT_EQ(r.report.frames_dropped, 5u);
   EXPECT_EQ(r.report.frames_completed, 5u);
   // End to end (done - sensor time): 25, 40, 45, 50, 45 ms.
   EXPECT_EQ(r.report.end_to_end.count(), 5u);
-  EXPECT_EQ(r.report.end_to_end.maxNs(), 50 * kMs);
-  EXPECT_EQ(r.report.end_to_end.minNs(), 25 * kMs);
-  EXPECT_DOUBLE_EQ(r.report.end_to_end.meanNs(), 41.0 * kMs);
-  EXPECT_EQ(r.report.stages[1].latency.maxNs(), 25 * kMs);
-  EXPECT_EQ(r.end_time_ns, 125 * kMs);
+  EXPECT_EQ(r.report.end_to_end.maxNs(), 50 * kSimulatedMs);
+  EXPECT_EQ(r.report.end_to_end.minNs(), 25 * kSimulatedMs);
+  EXPECT_DOUBLE_EQ(r.report.end_to_end.meanNs(), 41.0 * kSimulatedMs);
+  EXPECT_EQ(r.report.stages[1].latency.maxNs(), 25 * kSimulatedMs);
+  EXPECT_EQ(r.end_time_ns, 125 * kSimulatedMs);
   EXPECT_EQ(r.free_slots_after, 2u);
 }
 
 TEST(RealtimeSimulation, StagesOverlapLikeThreads) {
   // Two 8 ms stages at 10 ms per frame: a frame is in flight 16 ms, but mix works on frame n+1
   // while fold works on frame n, so two slots suffice and nothing drops.
-  const Simulated r = simulate(30, 10 * kMs, 2, 8 * kMs, 8 * kMs);
+  const Simulated r = simulate(30, 10 * kSimulatedMs, 2, 8 * kSimulatedMs, 8 * kSimulatedMs);
   EXPECT_TRUE(r.dropped.empty());
   EXPECT_EQ(r.report.frames_completed, 30u);
-  EXPECT_EQ(r.report.end_to_end.minNs(), 16 * kMs);
-  EXPECT_EQ(r.report.end_to_end.maxNs(), 16 * kMs);
-  EXPECT_EQ(r.end_time_ns, 29 * 10 * kMs + 16 * kMs);
+  EXPECT_EQ(r.report.end_to_end.minNs(), 16 * kSimulatedMs);
+  EXPECT_EQ(r.report.end_to_end.maxNs(), 16 * kSimulatedMs);
+  EXPECT_EQ(r.end_time_ns, 29 * 10 * kSimulatedMs + 16 * kSimulatedMs);
 }
 
 TEST(RealtimeSimulation, OneSlotMeansOneFrameInFlight) {
   // Same stages, one slot: each frame holds it for 16 ms, so every other frame finds it taken.
-  const Simulated r = simulate(10, 10 * kMs, 1, 8 * kMs, 8 * kMs);
+  const Simulated r = simulate(10, 10 * kSimulatedMs, 1, 8 * kSimulatedMs, 8 * kSimulatedMs);
   EXPECT_EQ(r.processed, (std::vector<uint64_t>{0, 2, 4, 6, 8}));
   EXPECT_EQ(r.dropped, (std::vector<uint64_t>{1, 3, 5, 7, 9}));
 }
 
 TEST(RealtimeSimulation, FastEnoughStagesDropNothingAndLatencyIsTheirCost) {
-  const Simulated r = simulate(100, 33 * kMs, 4, 5 * kMs, 7 * kMs);
+  const Simulated r = simulate(100, 33 * kSimulatedMs, 4, 5 * kSimulatedMs, 7 * kSimulatedMs);
   EXPECT_TRUE(r.dropped.empty());
   EXPECT_EQ(r.report.frames_completed, 100u);
-  EXPECT_EQ(r.report.end_to_end.maxNs(), 12 * kMs);
-  EXPECT_EQ(r.report.end_to_end.percentileNs(0.99), 12 * kMs);
+  EXPECT_EQ(r.report.end_to_end.maxNs(), 12 * kSimulatedMs);
+  EXPECT_EQ(r.report.end_to_end.percentileNs(0.99), 12 * kSimulatedMs);
 }
 
 TEST(RealtimeSimulation, EndToEndCanEndAtAnEarlierStage) {
   // As above, but end to end stops when "mix" is done (for plumb: the pose is known when tracking
   // is done; mapping after it refines the map): 5 ms, the fold stage's 7 ms not included.
-  const Simulated r = simulate(100, 33 * kMs, 4, 5 * kMs, 7 * kMs, 1);
+  const Simulated r = simulate(100, 33 * kSimulatedMs, 4, 5 * kSimulatedMs, 7 * kSimulatedMs, 1);
   EXPECT_EQ(r.report.frames_completed, 100u);
-  EXPECT_EQ(r.report.end_to_end.maxNs(), 5 * kMs);
+  EXPECT_EQ(r.report.end_to_end.maxNs(), 5 * kSimulatedMs);
   EXPECT_EQ(r.report.end_to_end_stage, 1);
   EXPECT_NE(formatRunReport(r.report).find("sensor time to 'mix' done"), std::string::npos)
       << formatRunReport(r.report);
-  EXPECT_EQ(simulate(5, 33 * kMs, 4, 5 * kMs, 7 * kMs).report.end_to_end_stage, 2);  // default: last
+  EXPECT_EQ(simulate(5, 33 * kSimulatedMs, 4, 5 * kSimulatedMs, 7 * kSimulatedMs).report.end_to_end_stage, 2);  // default: last
 }
 
 TEST(RealtimeSimulation, ASourceThatFallsBehindSkipsLateFramesInsteadOfLaggingForever) {
@@ -121,13 +121,13 @@ TEST(RealtimeSimulation, ASourceThatFallsBehindSkipsLateFramesInsteadOfLaggingFo
   //   f4 due 40 start 45 lag 5    f5 due 50 start 60 lag 10   f6 due 60 start 75 lag 15 -> late
   //   f7 due 70 start 75 lag 5    f8 due 80 start 90 lag 10   f9 due 90 start 105 lag 15 -> late
   VirtualClock clock;
-  ToySource source(10, 10 * kMs, -1, &clock, 15 * kMs);
+  ToySource source(10, 10 * kSimulatedMs, -1, &clock, 15 * kSimulatedMs);
   MixStage mix;
   FoldStage fold(10);
   RunOptions options;
   options.mode = RunMode::kRealtime;
   options.clock = &clock;
-  options.max_source_lag_ns = 12 * kMs;
+  options.max_source_lag_ns = 12 * kSimulatedMs;
   StageRunner<ToyFrame> runner(source, {&mix, &fold}, options);
   ASSERT_TRUE(runner.run().ok());
   std::vector<uint64_t> late;
@@ -139,12 +139,12 @@ TEST(RealtimeSimulation, ASourceThatFallsBehindSkipsLateFramesInsteadOfLaggingFo
   EXPECT_EQ(runner.report().frames_dropped, 0u);
   EXPECT_EQ(fold.frameIndices(), (std::vector<uint64_t>{0, 1, 2, 4, 5, 7, 8}));
   // End to end includes the source's lag: f2 was due at 20 and done at 45.
-  EXPECT_EQ(runner.report().end_to_end.maxNs(), 25 * kMs);
+  EXPECT_EQ(runner.report().end_to_end.maxNs(), 25 * kSimulatedMs);
   EXPECT_EQ(source.consumed(), 10u);
 
   // Without the limit every frame is read, ever later: f9 is due at 90 and done at 150.
   VirtualClock clock2;
-  ToySource source2(10, 10 * kMs, -1, &clock2, 15 * kMs);
+  ToySource source2(10, 10 * kSimulatedMs, -1, &clock2, 15 * kSimulatedMs);
   FoldStage fold2(10);
   options.clock = &clock2;
   options.max_source_lag_ns = 0;
@@ -152,12 +152,12 @@ TEST(RealtimeSimulation, ASourceThatFallsBehindSkipsLateFramesInsteadOfLaggingFo
   ASSERT_TRUE(unlimited.run().ok());
   EXPECT_EQ(unlimited.report().frames_late, 0u);
   EXPECT_EQ(unlimited.report().frames_completed, 10u);
-  EXPECT_EQ(unlimited.report().end_to_end.maxNs(), 60 * kMs);
+  EXPECT_EQ(unlimited.report().end_to_end.maxNs(), 60 * kSimulatedMs);
 }
 
 TEST(RealtimeSimulation, IsReproducible) {
-  const Simulated a = simulate(200, 10 * kMs, 3, 13 * kMs, 9 * kMs);
-  const Simulated b = simulate(200, 10 * kMs, 3, 13 * kMs, 9 * kMs);
+  const Simulated a = simulate(200, 10 * kSimulatedMs, 3, 13 * kSimulatedMs, 9 * kSimulatedMs);
+  const Simulated b = simulate(200, 10 * kSimulatedMs, 3, 13 * kSimulatedMs, 9 * kSimulatedMs);
   EXPECT_EQ(a.processed, b.processed);
   EXPECT_EQ(a.dropped, b.dropped);
   EXPECT_FALSE(a.dropped.empty());  // 13 ms per frame cannot keep up with 10 ms

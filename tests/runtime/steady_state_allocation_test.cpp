@@ -16,7 +16,7 @@ using testing::MixStage;
 using testing::ToyFrame;
 using testing::ToySource;
 
-constexpr uint64_t kFrames = 200;
+constexpr uint64_t kSteadyFrames = 200;
 constexpr uint64_t kWarmupFrames = 30;
 
 // Reads the process-wide allocation counter when the first frame at or after kWarmupFrames enters
@@ -24,7 +24,7 @@ constexpr uint64_t kWarmupFrames = 30;
 // (Real-time mode may drop a frame on a loaded machine; the contract holds for those too.)
 class CountingSource final : public Source<ToyFrame> {
  public:
-  explicit CountingSource(std::atomic<uint64_t>* at_warm) : inner_(kFrames, 2'000'000), at_warm_(at_warm) {}
+  explicit CountingSource(std::atomic<uint64_t>* at_warm) : inner_(kSteadyFrames, 2'000'000), at_warm_(at_warm) {}
   bool peekNext(int64_t* t) override { return inner_.peekNext(t); }
   Status read(ToyFrame& frame, const FrameStamps& stamps) override {
     if (!warm_ && stamps.frame_index >= kWarmupFrames) {
@@ -68,7 +68,7 @@ TEST_P(SteadyState, ZeroAllocationsPerFrameAfterWarmup) {
   std::atomic<uint64_t> at_end{0};
   CountingSource source(&at_warm);
   MixStage mix;
-  FoldStage fold(kFrames);
+  FoldStage fold(kSteadyFrames);
   CountingSink sink(&at_end);
   RunOptions options;
   options.mode = GetParam();
@@ -83,13 +83,13 @@ TEST_P(SteadyState, ZeroAllocationsPerFrameAfterWarmup) {
   StageRunner<ToyFrame> runner(source, {&mix, &fold, &sink}, options);
   ASSERT_TRUE(runner.run().ok());
   if (GetParam() != RunMode::kRealtime) {
-    ASSERT_EQ(runner.report().frames_completed, kFrames);
+    ASSERT_EQ(runner.report().frames_completed, kSteadyFrames);
   }
-  ASSERT_GE(sink.steadyFrames(), (kFrames - kWarmupFrames) / 2) << "too few frames to judge";
+  ASSERT_GE(sink.steadyFrames(), (kSteadyFrames - kWarmupFrames) / 2) << "too few frames to judge";
   ASSERT_GT(at_warm.load(), 0u);
   ASSERT_GE(at_end.load(), at_warm.load());
   const uint64_t allocations = at_end.load() - at_warm.load();
-  EXPECT_EQ(allocations, 0u) << allocations << " allocations over " << kFrames - kWarmupFrames
+  EXPECT_EQ(allocations, 0u) << allocations << " allocations over " << kSteadyFrames - kWarmupFrames
                              << " steady-state frames";
 }
 

@@ -122,7 +122,7 @@ Eigen::Matrix3d referenceScaleStereoInformation(const Eigen::Matrix3d& informati
 // Bit for bit where the compiler evaluates both forms with the same roundings (x86-64 without FMA,
 // the release build); elsewhere (aarch64: GCC contracts a * b + c into fused multiply-adds, in each
 // form differently) within a relative 1e-12, as the other kernel oracles of tests/solver.
-void expectSameBits(const Eigen::Matrix3d& got, const Eigen::Matrix3d& expected, int trial) {
+void expectSameBits3x3(const Eigen::Matrix3d& got, const Eigen::Matrix3d& expected, int trial) {
   for (int i = 0; i < 9; ++i) {
 #if defined(__x86_64__) && !defined(__FMA__)
     ASSERT_EQ(std::memcmp(&got(i), &expected(i), sizeof(double)), 0)
@@ -172,7 +172,7 @@ TEST(VarianceFactor, ScaledStereoInformationEqualsTheMatrixFormBitForBit) {
     }
     const double pixel = trial % 9 == 0 ? 1.0 : scale();
     const double depth = trial % 10 == 0 ? 1.0 : scale();
-    expectSameBits(scaleStereoInformation(information, pixel, depth),
+    expectSameBits3x3(scaleStereoInformation(information, pixel, depth),
                    referenceScaleStereoInformation(information, pixel, depth), trial);
   }
   // Scales that are zero, negative or not finite take the matrix form.

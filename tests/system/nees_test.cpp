@@ -10,7 +10,7 @@
 namespace plumb::test {
 namespace {
 
-constexpr int kFrames = 100;
+constexpr int kNeesFrames = 100;
 
 struct Pooled {
   PooledNees relative, world, motion;
@@ -19,9 +19,9 @@ struct Pooled {
 Pooled runSeeds(const SystemOptions& options, int seeds, const char* preset = "textured") {
   Pooled p;
   for (int seed = 1; seed <= seeds; ++seed) {
-    const NeesRun run = runSyntheticNees(kinectSynth(preset, uint64_t(seed), kFrames), options);
+    const NeesRun run = runSyntheticNees(kinectSynth(preset, uint64_t(seed), kNeesFrames), options);
     EXPECT_TRUE(run.status.ok()) << run.status.message();
-    EXPECT_EQ(run.frames_with_pose, std::size_t(kFrames)) << "seed " << seed;
+    EXPECT_EQ(run.frames_with_pose, std::size_t(kNeesFrames)) << "seed " << seed;
     p.relative.add(run.nees.keyframe_relative);
     p.world.add(run.nees.tracked_world);
     p.motion.add(run.nees.frame_motion);
@@ -35,7 +35,7 @@ Pooled runSeeds(const SystemOptions& options, int seeds, const char* preset = "t
 TEST(NeesMonteCarlo, CalibratedCovariancesHoldTheirErrorsAndTheModelAsItIsDoesNot) {
   const Pooled p = runSeeds(SystemOptions{}, 3);
   ASSERT_GE(p.relative.count, 8u);  // keyframe pairs with a joint-marginal relative covariance
-  ASSERT_GE(p.world.count, std::size_t(3 * (kFrames - 2)));
+  ASSERT_GE(p.world.count, std::size_t(3 * (kNeesFrames - 2)));
   std::printf("NEES/dof over 3 seeds: keyframe %.3f (n %zu), tracked %.3f (n %zu), motion %.3f (n %zu)\n",
               p.relative.meanPerDof(), p.relative.count, p.world.meanPerDof(), p.world.count, p.motion.meanPerDof(),
               p.motion.count);

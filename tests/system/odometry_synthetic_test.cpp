@@ -6,19 +6,19 @@
 namespace plumb::test {
 namespace {
 
-constexpr int kFrames = 180;
+constexpr int kSyntheticFrames = 180;
 
 OdometryRun runLowTexture(bool lines, std::vector<StampedPose>* gt) {
   std::unique_ptr<SyntheticSource> source;
-  EXPECT_TRUE(SyntheticSource::create(noisySynth("low_texture", kFrames), &source).ok());
-  *gt = groundTruth(source->scene(), kFrames);
+  EXPECT_TRUE(SyntheticSource::create(noisySynth("low_texture", kSyntheticFrames), &source).ok());
+  *gt = groundTruth(source->scene(), kSyntheticFrames);
   return runOdometry(*source, systemOptions(lines));
 }
 
 TEST(OdometrySynthetic, LowTextureEveryFrameTrackedAndAccurate) {
   std::vector<StampedPose> gt;
   const OdometryRun run = runLowTexture(true, &gt);
-  ASSERT_EQ(run.trajectory.size(), std::size_t(kFrames));
+  ASSERT_EQ(run.trajectory.size(), std::size_t(kSyntheticFrames));
   EXPECT_EQ(run.stats.frames_lost, 0u);
   EXPECT_EQ(run.stats.frames_not_initialized, 0u);
   EXPECT_EQ(run.stats.segments, 1u);

@@ -16,7 +16,7 @@
 namespace plumb {
 namespace {
 
-constexpr int kFrames = 40;
+constexpr int kDropFrames = 40;
 constexpr int kSlowFrame = 10;
 constexpr int64_t kSlowNs = 190'000'000;  // 5.7 frame periods at 30 Hz
 
@@ -49,10 +49,10 @@ class SlowOnceSink final : public OdometrySink {
 void runWithSlowMapStage(DropRun* run) {
   SynthOptions synth;
   synth.preset = "textured";
-  synth.frames = kFrames;
+  synth.frames = kDropFrames;
   std::unique_ptr<SyntheticSource> source;
   ASSERT_TRUE(SyntheticSource::create(synth, &source).ok());
-  for (int i = 0; i < kFrames; ++i) run->source_timestamps.push_back(source->scene().timestamp(i));
+  for (int i = 0; i < kDropFrames; ++i) run->source_timestamps.push_back(source->scene().timestamp(i));
 
   runtime::VirtualClock clock;
   OdometryRunOptions options;
@@ -72,12 +72,12 @@ TEST(StagedDrops, SlowMapStageDropsExactlyTheFramesThatFindNoSlot) {
   // so 14 (467 ms) and 15 (500 ms) find none; 16 (533 ms) finds the slots freed at 523 ms.
   EXPECT_EQ(run.result.report.frames_dropped, 2u);
   EXPECT_EQ(run.result.report.frames_late, 0u);
-  EXPECT_EQ(run.result.report.frames_completed, uint64_t(kFrames - 2));
+  EXPECT_EQ(run.result.report.frames_completed, uint64_t(kDropFrames - 2));
   EXPECT_EQ(run.result.drops_without_trajectory_line, 0u);
 
   // One output line per source frame, in source order; the dropped ones are exactly 14 and 15.
-  ASSERT_EQ(run.frames.size(), std::size_t(kFrames));
-  for (int i = 0; i < kFrames; ++i) {
+  ASSERT_EQ(run.frames.size(), std::size_t(kDropFrames));
+  for (int i = 0; i < kDropFrames; ++i) {
     EXPECT_DOUBLE_EQ(run.frames[std::size_t(i)].timestamp_s, run.source_timestamps[std::size_t(i)]) << i;
     const bool expect_dropped = i == 14 || i == 15;
     EXPECT_EQ(run.frames[std::size_t(i)].dropped, expect_dropped) << i;

@@ -22,9 +22,9 @@ namespace {
 using plumb::test::runPlumb;
 using plumb::test::RunResult;
 
-class ScratchDir : public plumb::test::ScratchDir {
+class StagedScratchDir : public plumb::test::ScratchDir {
  public:
-  ScratchDir() : plumb::test::ScratchDir("plumb_staged") {}
+  StagedScratchDir() : plumb::test::ScratchDir("plumb_staged") {}
 };
 
 namespace fs = std::filesystem;
@@ -71,7 +71,7 @@ class StagedRun : public ::testing::Test {
     if (result) *result = r;
     return readBytes(out);
   }
-  ScratchDir dir_;
+  StagedScratchDir dir_;
 };
 
 TEST_F(StagedRun, DeterministicModeWritesTheSingleThreadedBytes) {

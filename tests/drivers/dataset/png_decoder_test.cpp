@@ -14,7 +14,7 @@
 namespace plumb {
 namespace {
 
-std::vector<uint8_t> encode(const cv::Mat& image) {
+std::vector<uint8_t> encodePng(const cv::Mat& image) {
   std::vector<uint8_t> bytes;
   EXPECT_TRUE(cv::imencode(".png", image, bytes));
   return bytes;
@@ -66,22 +66,22 @@ TEST(PngDecoder, SixteenBitDepthAndColourMatchOpenCv) {
   cv::randu(colour, 0, 255);
   PngDecoder decoder;
   cv::Mat out;
-  ASSERT_TRUE(decode(decoder, encode(depth), out)) << decoder.error();
+  ASSERT_TRUE(decode(decoder, encodePng(depth), out)) << decoder.error();
   EXPECT_EQ(maxDifference(out, depth), 0.0);
-  ASSERT_TRUE(decode(decoder, encode(colour), out)) << decoder.error();
+  ASSERT_TRUE(decode(decoder, encodePng(colour), out)) << decoder.error();
   EXPECT_EQ(maxDifference(out, colour), 0.0);  // BGR, like OpenCV
 }
 
 TEST(PngDecoder, HeaderReportsWhatTheLoaderChecks) {
   PngDecoder decoder;
   PngHeader h;
-  const auto grey8 = encode(cv::Mat(6, 10, CV_8UC1, cv::Scalar(7)));
+  const auto grey8 = encodePng(cv::Mat(6, 10, CV_8UC1, cv::Scalar(7)));
   ASSERT_TRUE(decoder.readHeader(grey8.data(), grey8.size(), &h));
   EXPECT_EQ(h.width, 10);
   EXPECT_EQ(h.height, 6);
   EXPECT_EQ(h.bit_depth, 8);
   EXPECT_EQ(h.channels, 1);
-  const auto bgra = encode(cv::Mat(3, 4, CV_8UC4, cv::Scalar(1, 2, 3, 4)));
+  const auto bgra = encodePng(cv::Mat(3, 4, CV_8UC4, cv::Scalar(1, 2, 3, 4)));
   ASSERT_TRUE(decoder.readHeader(bgra.data(), bgra.size(), &h));
   EXPECT_EQ(h.channels, 4);
 }
@@ -149,7 +149,7 @@ TEST(PngDecoder, PaletteExpandsToBgr) {
 TEST(PngDecoder, CorruptionIsAnErrorNotNoise) {
   cv::Mat depth(32, 32, CV_16UC1);
   cv::randu(depth, 0, 65535);
-  const std::vector<uint8_t> good = encode(depth);
+  const std::vector<uint8_t> good = encodePng(depth);
   PngDecoder decoder;
   cv::Mat out;
   // A flipped bit in the middle of the file: compressed pixels (CRC / zlib check) or a chunk.
@@ -172,7 +172,7 @@ TEST(PngDecoder, CorruptionIsAnErrorNotNoise) {
 // a few dozen bytes made libpng malloc 1.8 GB before finding that the file ends. Now the claim is
 // refused against the file's size, from the arena, with a message.
 TEST(PngDecoder, ChunkLengthBeyondTheFileIsRefusedWithoutAllocatingIt) {
-  std::vector<uint8_t> bytes = encode(cv::Mat(1, 1, CV_8UC1, cv::Scalar(9)));
+  std::vector<uint8_t> bytes = encodePng(cv::Mat(1, 1, CV_8UC1, cv::Scalar(9)));
   const std::size_t after_ihdr = 8 + 4 + 4 + 13 + 4;  // signature, IHDR length, type, data, CRC
   const std::vector<uint8_t> huge_text = {0x6e, 0x74, 0x00, 0x00, 't', 'E', 'X', 't', 'C', 'o', 'm', 'm', 0};
   bytes.insert(bytes.begin() + long(after_ihdr), huge_text.begin(), huge_text.end());
@@ -183,14 +183,14 @@ TEST(PngDecoder, ChunkLengthBeyondTheFileIsRefusedWithoutAllocatingIt) {
   EXPECT_EQ(decoder.arenaOverflows(), 0u);  // before the fix: one 1.8 GB malloc
   // The decoder still reads a good file afterwards.
   cv::Mat out;
-  ASSERT_TRUE(decode(decoder, encode(cv::Mat(2, 3, CV_8UC1, cv::Scalar(4))), out)) << decoder.error();
+  ASSERT_TRUE(decode(decoder, encodePng(cv::Mat(2, 3, CV_8UC1, cv::Scalar(4))), out)) << decoder.error();
   EXPECT_EQ(out.at<uint8_t>(1, 2), 4);
 }
 
 TEST(PngDecoder, SecondDecodeIntoTheSameMatAllocatesNothing) {
   cv::Mat colour(480, 640, CV_8UC3);
   cv::randu(colour, 0, 255);
-  const std::vector<uint8_t> bytes = encode(colour);
+  const std::vector<uint8_t> bytes = encodePng(colour);
   PngDecoder decoder;
   cv::Mat out;
   ASSERT_TRUE(decode(decoder, bytes, out));

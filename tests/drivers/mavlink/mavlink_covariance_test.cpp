@@ -13,7 +13,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-Eigen::Isometry3d pose(const Eigen::Vector3d& rotation_vector, const Eigen::Vector3d& t) {
+Eigen::Isometry3d makePose(const Eigen::Vector3d& rotation_vector, const Eigen::Vector3d& t) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = expSO3(rotation_vector);
   T.translation() = t;
@@ -60,24 +60,24 @@ TEST(MavlinkFrames, CameraMotionMapsToFrdAxes) {
   const Eigen::Isometry3d T0 = localBodyPose(Eigen::Isometry3d::Identity(), frames);
   EXPECT_TRUE(T0.isApprox(Eigen::Isometry3d::Identity(), 1e-12));
   // Camera 1 m along its optical axis (world z) = 1 m forward (local x); world y (down) = local z.
-  EXPECT_TRUE(localBodyPose(pose(Eigen::Vector3d::Zero(), {0, 0, 1}), frames)
+  EXPECT_TRUE(localBodyPose(makePose(Eigen::Vector3d::Zero(), {0, 0, 1}), frames)
                   .translation()
                   .isApprox(Eigen::Vector3d(1, 0, 0), 1e-12));
-  EXPECT_TRUE(localBodyPose(pose(Eigen::Vector3d::Zero(), {0, 1, 0}), frames)
+  EXPECT_TRUE(localBodyPose(makePose(Eigen::Vector3d::Zero(), {0, 1, 0}), frames)
                   .translation()
                   .isApprox(Eigen::Vector3d(0, 0, 1), 1e-12));
-  EXPECT_TRUE(localBodyPose(pose(Eigen::Vector3d::Zero(), {1, 0, 0}), frames)
+  EXPECT_TRUE(localBodyPose(makePose(Eigen::Vector3d::Zero(), {1, 0, 0}), frames)
                   .translation()
                   .isApprox(Eigen::Vector3d(0, 1, 0), 1e-12));
   // Turning right = rotating about the camera's down axis (y) by +a: yaw +a.
   const double a = 0.4;
-  Eigen::Vector3d rpy = eulerRollPitchYaw(localBodyPose(pose({0, a, 0}, {0, 0, 0}), frames).linear());
+  Eigen::Vector3d rpy = eulerRollPitchYaw(localBodyPose(makePose({0, a, 0}, {0, 0, 0}), frames).linear());
   EXPECT_TRUE(rpy.isApprox(Eigen::Vector3d(0, 0, a), 1e-12)) << rpy.transpose();
   // Nose up = rotating about the camera's right axis (x) by +a (z swings toward -y, up): pitch +a.
-  rpy = eulerRollPitchYaw(localBodyPose(pose({a, 0, 0}, {0, 0, 0}), frames).linear());
+  rpy = eulerRollPitchYaw(localBodyPose(makePose({a, 0, 0}, {0, 0, 0}), frames).linear());
   EXPECT_TRUE(rpy.isApprox(Eigen::Vector3d(0, a, 0), 1e-12)) << rpy.transpose();
   // Right wing down = rotating about the optical axis (z) by +a: roll +a.
-  rpy = eulerRollPitchYaw(localBodyPose(pose({0, 0, a}, {0, 0, 0}), frames).linear());
+  rpy = eulerRollPitchYaw(localBodyPose(makePose({0, 0, a}, {0, 0, 0}), frames).linear());
   EXPECT_TRUE(rpy.isApprox(Eigen::Vector3d(a, 0, 0), 1e-12)) << rpy.transpose();
 }
 
@@ -101,12 +101,12 @@ TEST(MavlinkCovariance, JacobianMatchesFiniteDifferences) {
     MavlinkFrameChange frames;
     if (trial % 2 == 1) {  // a non-trivial mounting: rotated and offset
       frames.T_body_cam =
-          pose({0.3 * u(rng), 0.3 * u(rng), 0.3 * u(rng)}, {0.2 * u(rng), 0.2 * u(rng), 0.2 * u(rng)}) *
+          makePose({0.3 * u(rng), 0.3 * u(rng), 0.3 * u(rng)}, {0.2 * u(rng), 0.2 * u(rng), 0.2 * u(rng)}) *
           forwardCameraBodyFrdExtrinsic();
       frames.T_local_world = frames.T_body_cam;
     }
     const Eigen::Isometry3d T_world_cam =
-        pose({0.6 * u(rng), 0.6 * u(rng), 0.6 * u(rng)}, {3 * u(rng), 3 * u(rng), 3 * u(rng)});
+        makePose({0.6 * u(rng), 0.6 * u(rng), 0.6 * u(rng)}, {3 * u(rng), 3 * u(rng), 3 * u(rng)});
     const Matrix6d J = mavlinkPoseJacobian(T_world_cam, frames);
     const Matrix6d J_numeric = numericJacobian(T_world_cam, frames);
     EXPECT_LT((J - J_numeric).cwiseAbs().maxCoeff(), 1e-6) << "trial " << trial << "\nanalytic\n"
@@ -162,8 +162,8 @@ TEST(MavlinkFrames, VelocityCovarianceMatchesSampling) {
   std::normal_distribution<double> n(0.0, 1.0);
   MavlinkFrameChange frames;
   frames.T_body_cam.translation() = Eigen::Vector3d(0.4, -0.1, 0.2);  // a lever arm
-  const Eigen::Isometry3d T_world_cam_previous = pose(Eigen::Vector3d(0.2, -0.4, 0.1), Eigen::Vector3d(0.5, 0.2, 1.0));
-  const Eigen::Isometry3d T_world_cam = T_world_cam_previous * pose(Eigen::Vector3d(0.01, 0.015, -0.005),
+  const Eigen::Isometry3d T_world_cam_previous = makePose(Eigen::Vector3d(0.2, -0.4, 0.1), Eigen::Vector3d(0.5, 0.2, 1.0));
+  const Eigen::Isometry3d T_world_cam = T_world_cam_previous * makePose(Eigen::Vector3d(0.01, 0.015, -0.005),
                                                                     Eigen::Vector3d(0.02, -0.01, 0.03));
   const double dt = 1.0 / 30.0;
   Matrix6d A = Matrix6d::Zero(), B = Matrix6d::Zero();

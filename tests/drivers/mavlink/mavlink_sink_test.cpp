@@ -416,7 +416,7 @@ int openPty(std::string* slave_path) {
   return master;
 }
 
-std::vector<uint8_t> readAll(int fd) {
+std::vector<uint8_t> readAllFromFd(int fd) {
   std::vector<uint8_t> bytes;
   uint8_t buf[4096];
   for (;;) {
@@ -448,9 +448,9 @@ TEST(MavlinkSink, SerialDropsWhenFullAndKeepsTheStreamFrameAligned) {
   EXPECT_GT(full.odometry_sent, 0u);
 
   // Drain, send once more (flushes any torn tail first), drain again: whole frames only.
-  std::vector<uint8_t> stream = readAll(master);
+  std::vector<uint8_t> stream = readAllFromFd(master);
   sink.publish(sampleAt(kMessages), kMessages * kSecond / 30);
-  const std::vector<uint8_t> rest = readAll(master);
+  const std::vector<uint8_t> rest = readAllFromFd(master);
   stream.insert(stream.end(), rest.begin(), rest.end());
   std::size_t pos = 0;
   uint64_t odometry = 0, heartbeats = 0;

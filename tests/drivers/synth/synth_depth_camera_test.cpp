@@ -23,7 +23,7 @@
 namespace plumb {
 namespace {
 
-std::unique_ptr<SyntheticScene> makeScene(const std::string& preset, uint64_t seed, std::optional<DepthCamera> depth) {
+std::unique_ptr<SyntheticScene> makeSceneWithDepth(const std::string& preset, uint64_t seed, std::optional<DepthCamera> depth) {
   SynthOptions options;
   options.preset = preset;
   options.seed = seed;
@@ -35,9 +35,9 @@ std::unique_ptr<SyntheticScene> makeScene(const std::string& preset, uint64_t se
 }
 
 TEST(SynthDepthCamera, ColourAndGroundTruthStayTheColourCamerasDepthIsTheDepthCameras) {
-  const auto registered = makeScene("textured", 3, std::nullopt);
-  const auto offset = makeScene("textured", 3, synthOffsetDepthCamera());
-  const auto qvga = makeScene("textured", 3, synthOffsetDepthCameraQvga());
+  const auto registered = makeSceneWithDepth("textured", 3, std::nullopt);
+  const auto offset = makeSceneWithDepth("textured", 3, synthOffsetDepthCamera());
+  const auto qvga = makeSceneWithDepth("textured", 3, synthOffsetDepthCameraQvga());
   ASSERT_TRUE(registered && offset && qvga);
   EXPECT_TRUE(registered->camera().depthRegistered());
   ASSERT_FALSE(offset->camera().depthRegistered());
@@ -95,9 +95,9 @@ DepthAgreement compare(const cv::Mat& truth, const cv::Mat& depth) {
 // the narrower depth camera sees (~83%). The same images taken as registered agree far less.
 TEST(SynthDepthCamera, RegisteredOffsetDepthMatchesTheColourCamerasDepth) {
   for (const char* preset : {"textured", "fast_rotation"}) {
-    const auto registered = makeScene(preset, 5, std::nullopt);
-    const auto offset = makeScene(preset, 5, synthOffsetDepthCamera());
-    const auto qvga = makeScene(preset, 5, synthOffsetDepthCameraQvga());
+    const auto registered = makeSceneWithDepth(preset, 5, std::nullopt);
+    const auto offset = makeSceneWithDepth(preset, 5, synthOffsetDepthCamera());
+    const auto qvga = makeSceneWithDepth(preset, 5, synthOffsetDepthCameraQvga());
     ASSERT_TRUE(registered && offset && qvga);
     DepthRegistration registration(offset->camera());
     DepthRegistration registration_qvga(qvga->camera());

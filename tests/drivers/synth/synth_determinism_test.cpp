@@ -10,7 +10,7 @@
 namespace plumb {
 namespace {
 
-std::unique_ptr<SyntheticScene> makeScene(const SynthOptions& options) {
+std::unique_ptr<SyntheticScene> makeSceneFromOptions(const SynthOptions& options) {
   std::unique_ptr<SyntheticScene> scene;
   const Status status = SyntheticScene::create(options, &scene);
   EXPECT_TRUE(status.ok()) << status.message();
@@ -40,8 +40,8 @@ SynthOptions noisyOptions(const std::string& preset, uint64_t seed) {
 TEST(SynthDeterminism, SameSeedGivesIdenticalBytesAcrossScenesAndRenders) {
   for (const char* preset : {"textured", "low_texture", "fast_rotation"}) {
     SCOPED_TRACE(preset);
-    auto first = makeScene(noisyOptions(preset, 7));
-    auto second = makeScene(noisyOptions(preset, 7));
+    auto first = makeSceneFromOptions(noisyOptions(preset, 7));
+    auto second = makeSceneFromOptions(noisyOptions(preset, 7));
     RgbdImage a, b, again;
     ASSERT_TRUE(first->render(17, a).ok());
     ASSERT_TRUE(second->render(17, b).ok());
@@ -59,8 +59,8 @@ TEST(SynthDeterminism, SameSeedGivesIdenticalBytesAcrossScenesAndRenders) {
 }
 
 TEST(SynthDeterminism, DifferentSeedGivesADifferentScene) {
-  auto seven = makeScene(noisyOptions("textured", 7));
-  auto eight = makeScene(noisyOptions("textured", 8));
+  auto seven = makeSceneFromOptions(noisyOptions("textured", 7));
+  auto eight = makeSceneFromOptions(noisyOptions("textured", 8));
   RgbdImage a, b;
   ASSERT_TRUE(seven->render(0, a).ok());
   ASSERT_TRUE(eight->render(0, b).ok());
@@ -73,7 +73,7 @@ TEST(SynthDeterminism, NoiseChangesFromFrameToFrameButNotRunToRun) {
   // Same pose, different frame index: make the path stand still by sampling one lap apart.
   SynthOptions options = noisyOptions("low_texture", 3);
   options.frames = 700;
-  auto scene = makeScene(options);
+  auto scene = makeSceneFromOptions(options);
   RgbdImage lap0, lap1;
   ASSERT_TRUE(scene->render(10, lap0).ok());
   ASSERT_TRUE(scene->render(10 + 600, lap1).ok());  // 20 s period at 30 fps = 600 frames
@@ -82,7 +82,7 @@ TEST(SynthDeterminism, NoiseChangesFromFrameToFrameButNotRunToRun) {
   EXPECT_GT(differing, 0.3) << "pixel noise must be drawn per frame";
   options.pixel_noise_sigma = 0;
   options.depth_noise = false;
-  auto clean = makeScene(options);
+  auto clean = makeSceneFromOptions(options);
   ASSERT_TRUE(clean->render(10, lap0).ok());
   ASSERT_TRUE(clean->render(610, lap1).ok());
   EXPECT_TRUE(sameBytes(lap0.bgr, lap1.bgr)) << "noise-free renders of one pose must match exactly";
@@ -91,7 +91,7 @@ TEST(SynthDeterminism, NoiseChangesFromFrameToFrameButNotRunToRun) {
 TEST(SynthDeterminism, RenderFillsTimestampsAndReusesBuffers) {
   SynthOptions options;
   options.frames = 10;
-  auto scene = makeScene(options);
+  auto scene = makeSceneFromOptions(options);
   RgbdImage frame;
   ASSERT_TRUE(scene->render(0, frame).ok());
   const uchar* bgr_data = frame.bgr.data;
@@ -111,7 +111,7 @@ TEST(SynthDeterminism, SteadyStateRenderingDoesNotAllocate) {
   // through the data pointers. This catches operator new in the renderer and the sensor model.
   // A face's texture is painted when a frame first shows it (OpenCV's drawing and blur allocate
   // then), so the steady state is frames whose faces have been seen: here, the same frames again.
-  auto scene = makeScene(noisyOptions("textured", 2));
+  auto scene = makeSceneFromOptions(noisyOptions("textured", 2));
   RgbdImage frame;
   for (int i = 0; i < 4; ++i) ASSERT_TRUE(scene->render(i, frame).ok());  // Mats and textures
   AllocationScope scope;

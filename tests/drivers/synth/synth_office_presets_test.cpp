@@ -14,7 +14,7 @@
 namespace plumb {
 namespace {
 
-std::unique_ptr<SyntheticScene> makeScene(const std::string& preset, uint64_t seed) {
+std::unique_ptr<SyntheticScene> makeOfficeScene(const std::string& preset, uint64_t seed) {
   SynthOptions options;
   options.preset = preset;
   options.seed = seed;
@@ -28,7 +28,7 @@ TEST(SynthOfficePresets, LoopRevisitsAndStaysInsideTheRoom) {
   EXPECT_EQ(presetDefaultFrames("office_loop"), 1200);
   for (uint64_t seed : {1, 3}) {
     SCOPED_TRACE("seed " + std::to_string(seed));
-    const auto scene = makeScene("office_loop", seed);
+    const auto scene = makeOfficeScene("office_loop", seed);
     double max_revisit_m = 0;
     for (int i = 0; i < 600; i += 10) {
       const Eigen::Vector3d p = scene->T_world_cam(i).translation();
@@ -47,7 +47,7 @@ TEST(SynthOfficePresets, LoopRevisitsAndStaysInsideTheRoom) {
 
 TEST(SynthOfficePresets, PassNeverComesBack) {
   EXPECT_EQ(presetDefaultFrames("office_pass"), 800);
-  const auto scene = makeScene("office_pass", 1);
+  const auto scene = makeOfficeScene("office_pass", 1);
   for (int i = 90; i < 800; i += 15) {
     const Eigen::Vector3d p = scene->T_world_cam(i).translation();
     for (int j = 0; j + 60 < i; j += 5) {
@@ -59,7 +59,7 @@ TEST(SynthOfficePresets, PassNeverComesBack) {
 TEST(SynthOfficePresets, RenderDeterministically) {
   for (const char* preset : {"office_loop", "office_pass"}) {
     SCOPED_TRACE(preset);
-    const auto a = makeScene(preset, 2), b = makeScene(preset, 2);
+    const auto a = makeOfficeScene(preset, 2), b = makeOfficeScene(preset, 2);
     RgbdImage x, y;
     ASSERT_TRUE(a->render(120, x).ok());
     ASSERT_TRUE(b->render(120, y).ok());

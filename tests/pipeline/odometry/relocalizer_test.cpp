@@ -19,16 +19,16 @@ const Eigen::Isometry3d kKeyframe = pose(15, Eigen::Vector3d(0, 1, 0.2), Eigen::
 // Farther than tracking could bridge: 8 deg and 15 cm.
 const Eigen::Isometry3d kOffset = pose(8, Eigen::Vector3d(0.3, 1, -0.1), Eigen::Vector3d(0.12, -0.05, 0.07));
 
-struct Fixture {
+struct RelocalizerFixture {
   PinholeCamera camera = test::syntheticCamera();
   OdometryOptions options;
   std::unique_ptr<Relocalizer> relocalizer;
-  Fixture() { relocalizer = std::make_unique<Relocalizer>(camera, options); }
+  RelocalizerFixture() { relocalizer = std::make_unique<Relocalizer>(camera, options); }
 };
 
 TEST(Relocalizer, ReobservedKeyframeGivesTheTruePose) {
   const test::Scene scene = test::makeScene(21, 300, 0, kKeyframe, 1.0, 4.0);
-  Fixture fx;
+  RelocalizerFixture fx;
   // Unrelated keyframes, and decoys that share 40-100 descriptors with the scene in another
   // geometry (enough to be candidates): the ranking must try the right keyframe first.
   fx.relocalizer->addKeyframe(1, Eigen::Isometry3d::Identity(), *test::unrelatedView(5, 300).features);
@@ -61,7 +61,7 @@ TEST(Relocalizer, KeyframeFarFromTheOriginAndTurned) {
   // from the origin and turned, any mix-up of the two is metres off.
   const Eigen::Isometry3d T_keyframe = pose(130, Eigen::Vector3d(0.2, 1, -0.4), Eigen::Vector3d(6.0, -3.0, 4.0));
   const test::Scene scene = test::makeScene(26, 300, 0, T_keyframe, 1.0, 4.0);
-  Fixture fx;
+  RelocalizerFixture fx;
   fx.relocalizer->addKeyframe(4, T_keyframe, *test::observe(scene, T_keyframe).features);
   const Eigen::Isometry3d T_true = T_keyframe * kOffset;
   Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
@@ -74,7 +74,7 @@ TEST(Relocalizer, KeyframeFarFromTheOriginAndTurned) {
 
 TEST(Relocalizer, UnrelatedFeaturesDoNotRelocalize) {
   const test::Scene scene = test::makeScene(22, 300, 0, kKeyframe);
-  Fixture fx;
+  RelocalizerFixture fx;
   fx.relocalizer->addKeyframe(1, kKeyframe, *test::observe(scene, kKeyframe).features);
   Eigen::Isometry3d T_world_cam = pose(1, Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(1, 2, 3));
   const Eigen::Isometry3d untouched = T_world_cam;
@@ -83,7 +83,7 @@ TEST(Relocalizer, UnrelatedFeaturesDoNotRelocalize) {
   EXPECT_TRUE(T_world_cam.isApprox(untouched, 1e-15));
 
   // Nothing stored at all.
-  Fixture empty;
+  RelocalizerFixture empty;
   EXPECT_FALSE(empty.relocalizer->relocalize(*test::observe(scene, kKeyframe).features, &T_world_cam).success);
 }
 
@@ -91,7 +91,7 @@ TEST(Relocalizer, RightDescriptorsInAWrongGeometryDoNotRelocalize) {
   // The same descriptors, but each on another scene point (a shuffled scene): descriptor matching
   // succeeds, no rigid motion explains the correspondences, so RANSAC must refuse.
   const test::Scene scene = test::makeScene(24, 300, 0, kKeyframe);
-  Fixture fx;
+  RelocalizerFixture fx;
   fx.relocalizer->addKeyframe(1, kKeyframe, *test::observe(scene, kKeyframe).features);
   test::Scene shuffled = scene;
   for (std::size_t i = 0; i < shuffled.points.size(); ++i) {
@@ -105,7 +105,7 @@ TEST(Relocalizer, RightDescriptorsInAWrongGeometryDoNotRelocalize) {
 
 TEST(Relocalizer, UsesTheKeyframePoseRefinedByTheMapper) {
   const test::Scene scene = test::makeScene(25, 300, 0, kKeyframe);
-  Fixture fx;
+  RelocalizerFixture fx;
   // Stored at a first estimate; the mapper later refines it to kKeyframe.
   const Eigen::Isometry3d first_estimate = pose(2, Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0.05, 0, 0)) * kKeyframe;
   fx.relocalizer->addKeyframe(9, first_estimate, *test::observe(scene, kKeyframe).features);

@@ -17,14 +17,14 @@ using test::pose;
 using test::rotationErrorDeg;
 using test::translationError;
 
-struct Fixture {
+struct TrackerFixture {
   PinholeCamera camera = test::syntheticCamera();
   OdometryOptions options;
   std::unique_ptr<Tracker> tracker;
   std::unique_ptr<LocalMapper> mapper;
   std::unique_ptr<KeyframeRequest> request = std::make_unique<KeyframeRequest>();
 
-  explicit Fixture(const OdometryOptions& o = OdometryOptions()) : options(o) {
+  explicit TrackerFixture(const OdometryOptions& o = OdometryOptions()) : options(o) {
     tracker = std::make_unique<Tracker>(camera, options);
     mapper = std::make_unique<LocalMapper>(camera, options);
   }
@@ -44,7 +44,7 @@ const Eigen::Isometry3d kStep = pose(1.0, Eigen::Vector3d(0.3, 1, -0.2), Eigen::
 
 TEST(Tracker, RecoversTheTruePoseOfTheNextFrameFromPoints) {
   const test::Scene scene = test::makeScene(1, 300, 0, kStart);
-  Fixture fx;
+  TrackerFixture fx;
   const test::View first = test::observe(scene, kStart);
   ASSERT_EQ(first.features->keypoints.size(), 300u);
   const InsertResult inserted = fx.startMap(*first.features, 0, kStart);
@@ -83,7 +83,7 @@ TEST(Tracker, MotionScaleScalesOnlyTheVelocitysCovariance) {
     OdometryOptions options;
     options.uncertainty.motion_scale = motion_scale;
     options.uncertainty.tracked_scale = tracked_scale;
-    Fixture fx(options);
+    TrackerFixture fx(options);
     (void)fx.startMap(*first.features, 0, kStart);
     return fx.tracker->track(*second.features, 1, 0.1, nullptr);
   };
@@ -111,7 +111,7 @@ TEST(Tracker, FollowsASequenceWithConstantVelocity) {
   // scene's unique descriptors would forgive a poor prediction in the default 15 px window).
   OdometryOptions options;
   options.matcher.points.search_radius_px = 3;
-  Fixture fx(options);
+  TrackerFixture fx(options);
   const test::View first = test::observe(scene, start);
   fx.startMap(*first.features, 0, start);
   Eigen::Isometry3d T_true = start;
@@ -136,7 +136,7 @@ TEST(Tracker, RecoversThePoseFromLinesAlone) {
   const test::Scene scene = test::makeScene(3, 0, 60, kStart);
   OdometryOptions options;
   options.tracker.min_inliers_ok = 30;
-  Fixture fx(options);
+  TrackerFixture fx(options);
   const test::View first = test::observe(scene, kStart);
   ASSERT_GT(first.features->lines.size(), 45u);
   const InsertResult inserted = fx.startMap(*first.features, 0, kStart);
@@ -155,7 +155,7 @@ TEST(Tracker, RecoversThePoseFromLinesAlone) {
 
 TEST(Tracker, UnmatchableFrameIsLostNotPlacedSomewhere) {
   const test::Scene scene = test::makeScene(4, 300, 20, kStart);
-  Fixture fx;
+  TrackerFixture fx;
   const test::View first = test::observe(scene, kStart);
   fx.startMap(*first.features, 0, kStart);
 
@@ -176,7 +176,7 @@ TEST(Tracker, FewMatchesAreWeakOrLostNeverConfidentlyWrong) {
   // Only a handful of the map's points are still seen (the rest of the frame is unrelated):
   // whatever state is reported, an ok / weak pose must be the true one.
   const test::Scene scene = test::makeScene(5, 300, 0, kStart);
-  Fixture fx;
+  TrackerFixture fx;
   fx.startMap(*test::observe(scene, kStart).features, 0, kStart);
   const Eigen::Isometry3d T_true = kStart * kStep;
   test::Scene partial = scene;
@@ -204,7 +204,7 @@ TEST(Tracker, KeyframeRequestNamesTheRightLandmarks) {
   const test::Scene scene = test::makeScene(6, 300, 30, kStart);
   OdometryOptions options;
   options.keyframes.max_frames_between = 1;
-  Fixture fx(options);
+  TrackerFixture fx(options);
   const test::View first = test::observe(scene, kStart);
   fx.startMap(*first.features, 0, kStart);
   const LocalMap& map = fx.mapper->localMap();
@@ -269,7 +269,7 @@ TEST(Tracker, LastFrameFollowsTheCorrectionsOfANewSnapshot) {
   auto snapshot = std::make_unique<LocalMap>();
 
   for (int variant = 0; variant < 3; ++variant) {
-    Fixture fx;
+    TrackerFixture fx;
     fx.startMap(*test::observe(scene, kStart).features, 0, kStart);
     const TrackResult r = fx.tracker->track(*test::observe(scene, T1).features, 1, 0.1, nullptr);
     ASSERT_EQ(r.state, TrackingState::kOk);
@@ -316,7 +316,7 @@ TEST(Tracker, ALoopCorrectionMovesLandmarksTheSnapshotDoesNotList) {
   const Eigen::Isometry3d T1 = kStart * kStep, T2 = T1 * kStep;
   const Eigen::Isometry3d C = pose(1.5, Eigen::Vector3d(0.2, 1, 0.3), Eigen::Vector3d(0.06, -0.04, 0.03));
   for (const bool lines_only : {false, true}) {
-    Fixture fx;
+    TrackerFixture fx;
     const InsertResult start = fx.startMap(*test::observe(scene, kStart).features, 0, kStart);
     ASSERT_TRUE(start.inserted);
     test::View v1 = test::observe(scene, T1);
