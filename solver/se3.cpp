@@ -6,7 +6,6 @@
 namespace plumb {
 namespace {
 
-
 // vee of the skew part of R: 2 sin(theta) * axis.
 Eigen::Vector3d skewVee(const Eigen::Matrix3d& R) {
   return {R(2, 1) - R(1, 2), R(0, 2) - R(2, 0), R(1, 0) - R(0, 1)};

@@ -22,11 +22,6 @@ namespace {
 using plumb::test::runPlumb;
 using plumb::test::RunResult;
 
-class StagedScratchDir : public plumb::test::ScratchDir {
- public:
-  StagedScratchDir() : plumb::test::ScratchDir("plumb_staged") {}
-};
-
 namespace fs = std::filesystem;
 
 const std::string kPlumb = plumb::test::kPlumbBinary;
@@ -71,7 +66,7 @@ class StagedRun : public ::testing::Test {
     if (result) *result = r;
     return readBytes(out);
   }
-  StagedScratchDir dir_;
+  plumb::test::ScratchDir dir_{"plumb_staged"};
 };
 
 TEST_F(StagedRun, DeterministicModeWritesTheSingleThreadedBytes) {

@@ -19,11 +19,6 @@ namespace {
 using plumb::test::runPlumb;
 using plumb::test::RunResult;
 
-class EvalScratchDir : public plumb::test::ScratchDir {
- public:
-  EvalScratchDir() : plumb::test::ScratchDir("plumb_eval") {}
-};
-
 const std::string kReference = PLUMB_DATASETS_DIR "/reference_trajectories";
 
 bool haveReferenceTrajectories() { return std::filesystem::is_directory(kReference); }
@@ -39,7 +34,7 @@ TEST(EvalCli, Freiburg1XyzGivesThePublishedAte) {
 
 TEST(EvalCli, Freiburg2DeskJsonAndPlot) {
   if (!haveReferenceTrajectories()) GTEST_SKIP() << kReference << " not found: skipping";
-  EvalScratchDir dir;
+  plumb::test::ScratchDir dir{"plumb_eval"};
   const std::string plot = dir.file("plot.png");
   const RunResult r = runPlumb("eval --json --gt " + kReference + "/fr2_desk_groundtruth.txt --est " +
                                kReference + "/fr2_desk_ORB.txt --plot " + plot);
@@ -62,7 +57,7 @@ TEST(EvalCli, Freiburg2DeskJsonAndPlot) {
 
 // Values near the double range overflow the statistics: the JSON must stay JSON (null, never inf).
 TEST(EvalCli, JsonIsValidWhenTheNumbersOverflow) {
-  EvalScratchDir dir;
+  plumb::test::ScratchDir dir{"plumb_eval"};
   const std::string gt = dir.write("gt.txt", "1.0 1e308 0 0 0 0 0 1\n2.0 -1e308 0 0 0 0 0 1\n3.0 1e308 1e308 0 0 0 0 1\n");
   const std::string est = dir.write("est.txt", "1.0 0 0 0 0 0 0 1\n2.0 1 0 0 0 0 0 1\n3.0 2 1 0 0 0 0 1\n");
   const RunResult r = runPlumb("eval --gt " + gt + " --est " + est + " --json");
@@ -91,7 +86,7 @@ int colouredPixels(const cv::Mat& image) {
 // ICL-NUIM's TUM-format files have timestamps 1 s apart: the curves must still be drawn (a fixed
 // 0.5 s gap rule once broke them at every sample and left empty axes).
 TEST(EvalCli, PlotDrawsCurvesForSamplesOneSecondApart) {
-  EvalScratchDir dir;
+  plumb::test::ScratchDir dir{"plumb_eval"};
   std::string gt, est;
   for (int i = 0; i < 40; ++i) {
     const double a = 0.15 * i;
@@ -113,7 +108,7 @@ TEST(EvalCli, PlotDrawsCurvesForSamplesOneSecondApart) {
 }
 
 TEST(EvalCli, MissingFileExitsNonZeroNamingIt) {
-  EvalScratchDir dir;
+  plumb::test::ScratchDir dir{"plumb_eval"};
   const std::string gt = dir.write("gt.txt", "1.0 0 0 0 0 0 0 1\n");
   const RunResult r = runPlumb("eval --gt " + gt + " --est " + dir.file("missing_est.txt"));
   EXPECT_NE(r.exit_code, 0);
@@ -121,7 +116,7 @@ TEST(EvalCli, MissingFileExitsNonZeroNamingIt) {
 }
 
 TEST(EvalCli, CorruptFileExitsNonZeroNamingFileAndLine) {
-  EvalScratchDir dir;
+  plumb::test::ScratchDir dir{"plumb_eval"};
   const std::string gt = dir.write("gt.txt", "1.0 0 0 0 0 0 0 1\n2.0 0 0 0 0 0 0 1\n3.0 0 0 0 0 0 0 1\n");
   const std::string est = dir.write("est.txt", "1.0 0 0 0 0 0 0 1\n2.0 0 0 0 0 0 0 1\n3.0 0 0 nan 0 0 0 1\n");
   RunResult r = runPlumb("eval --gt " + gt + " --est " + est);
@@ -135,7 +130,7 @@ TEST(EvalCli, CorruptFileExitsNonZeroNamingFileAndLine) {
 }
 
 TEST(EvalCli, UnrelatedTrajectoriesAreAnErrorNotANumber) {
-  EvalScratchDir dir;
+  plumb::test::ScratchDir dir{"plumb_eval"};
   const std::string gt = dir.write("gt.txt", "1.0 0 0 0 0 0 0 1\n2.0 1 0 0 0 0 0 1\n3.0 2 0 0 0 0 0 1\n");
   const std::string est =
       dir.write("est.txt", "71.0 0 0 0 0 0 0 1\n72.0 1 0 0 0 0 0 1\n73.0 2 0 0 0 0 0 1\n");
@@ -145,7 +140,7 @@ TEST(EvalCli, UnrelatedTrajectoriesAreAnErrorNotANumber) {
 }
 
 TEST(EvalCli, UnwritablePlotIsAnErrorNamingThePath) {
-  EvalScratchDir dir;
+  plumb::test::ScratchDir dir{"plumb_eval"};
   std::string poses;
   for (int i = 0; i < 40; ++i)
     poses += std::to_string(1.0 + 0.1 * i) + " " + std::to_string(0.01 * i) + " 0 0 0 0 0 1\n";

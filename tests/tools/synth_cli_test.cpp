@@ -19,11 +19,6 @@ namespace {
 using plumb::test::runPlumb;
 using plumb::test::RunResult;
 
-class SynthScratchDir : public plumb::test::ScratchDir {
- public:
-  SynthScratchDir() : plumb::test::ScratchDir("plumb_synth") {}
-};
-
 namespace fs = std::filesystem;
 
 constexpr int kFrames = 20;  // keeps each run short; determinism does not depend on the count
@@ -46,7 +41,7 @@ std::string synthArguments(const std::string& preset, int seed, int frames, cons
 }
 
 TEST(SynthCli, SameSeedGivesByteIdenticalFolders) {
-  SynthScratchDir dir;
+  plumb::test::ScratchDir dir{"plumb_synth"};
   const std::string first = dir.file("first");
   const std::string second = dir.file("second");
   RunResult r = runPlumb(synthArguments("low_texture", 7, kFrames, first));
@@ -78,7 +73,7 @@ TEST(SynthCli, SameSeedGivesByteIdenticalFolders) {
 }
 
 TEST(SynthCli, DifferentSeedGivesDifferentBytes) {
-  SynthScratchDir dir;
+  plumb::test::ScratchDir dir{"plumb_synth"};
   const std::string seed7 = dir.file("seed7");
   const std::string seed8 = dir.file("seed8");
   constexpr int kFewFrames = 3;
@@ -103,7 +98,7 @@ TEST(SynthCli, DifferentSeedGivesDifferentBytes) {
 }
 
 TEST(SynthCli, UnknownPresetExitsNonZeroNamingIt) {
-  SynthScratchDir dir;
+  plumb::test::ScratchDir dir{"plumb_synth"};
   const RunResult r = runPlumb(synthArguments("marble_hall", 7, 2, dir.file("out")));
   EXPECT_NE(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("unknown preset 'marble_hall'"), std::string::npos) << r.output;
@@ -112,7 +107,7 @@ TEST(SynthCli, UnknownPresetExitsNonZeroNamingIt) {
 }
 
 TEST(SynthCli, ZeroOrMalformedFramesExitNonZero) {
-  SynthScratchDir dir;
+  plumb::test::ScratchDir dir{"plumb_synth"};
   RunResult r = runPlumb(synthArguments("textured", 7, 0, dir.file("out")));
   EXPECT_NE(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("frames must be positive"), std::string::npos) << r.output;
