@@ -5,7 +5,9 @@
 // L landmarks P_world (3-dof; map points and line-guidance points alike). Fixed keyframes
 // contribute residuals but no variables: they hold the gauge. Without any fixed keyframe the
 // problem has a 6-dof gauge freedom; LM damping still gives steps, but covariance() then fails.
-// Line samples carry no depth: a window constrained by lines alone also needs a second fixed
+// Line residuals carry no depth: a line sample's depth comes from a stereo observation in the
+// keyframe that back-projected it (its anchor: noise_model.h lineSampleAnchorInformation, added
+// by the local mapper); a window constrained by unanchored lines alone also needs a second fixed
 // keyframe to fix its scale.
 //
 // COST. 0.5 * sum_obs rho(e^T Omega e) with the factors of solver/factors.h (stereo [u,v,u_r],
@@ -201,7 +203,8 @@ class LocalBundleAdjuster {
   double cost(const LocalBaOptions& options) const;  // robust cost at the current estimate
   // A posteriori variance factor sigma0^2 (solver/variance_factor.h) of the inliers after solve():
   // redundancy = inlier error dof - 6 per optimised pose - per landmark min(its inlier error dof,
-  // 3 for a point, 2 for a line sample: its slide along the line is unobservable).
+  // 3 for a point, 2 for a line sample: its slide along the line is unobservable, 3 when its
+  // anchor observation pins that slide).
   // Read it before computeCovariance(), which may re-linearise (and so re-evaluate the chi2
   // values; the outlier flags stay solve()'s). local_ba_variance.cpp.
   double varianceFactor(const LocalBaOptions& options) const;
@@ -211,8 +214,8 @@ class LocalBundleAdjuster {
   // two are independent sensors: corner detection and the depth camera), and each part's inlier
   // chi2 is divided by its share of the points' redundancy (error dof - 6 per optimised pose - 3
   // per point landmark, shared in proportion to the parts' dof: a point seen V times has 2V - 2
-  // pixel and V - 1 depth redundancy). Line samples are left out: see docs/UNCERTAINTY.md (their
-  // residuals cannot show their noise). A part whose redundancy is below min_redundancy gets 1.
+  // pixel and V - 1 depth redundancy). Line samples are left out, their anchor observations too:
+  // see docs/UNCERTAINTY.md (their residuals cannot show their noise). A part whose redundancy is below min_redundancy gets 1.
   PointVarianceComponents varianceComponents(const LocalBaOptions& options, int min_redundancy = 30) const;
 
   // Diagnostics (tests): linearise at the current estimate and solve ONE damped step with the
@@ -264,6 +267,7 @@ class LocalBundleAdjuster {
   int addObservation(int keyframe, int landmark, ObservationKind kind, const Eigen::Vector3d& z,
                      const Eigen::Matrix3d& information);
   void buildStructure();
+  bool isLineSample(const Landmark& landmark) const;  // observed by a line-sample residual
   // IRLS normal equations at the current estimate into the per-keyframe / per-landmark /
   // per-observation blocks; returns the robust cost of the valid observations.
   double linearize(const LocalBaOptions& options);

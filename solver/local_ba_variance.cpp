@@ -8,21 +8,31 @@
 
 namespace plumb {
 
+bool LocalBundleAdjuster::isLineSample(const Landmark& landmark) const {
+  for (int k = 0; k < landmark.num_observations; ++k) {
+    if (observations_[observation_order_[landmark.first_observation + k]].kind == ObservationKind::kLineSample) return true;
+  }
+  return false;
+}
+
 double LocalBundleAdjuster::varianceFactor(const LocalBaOptions& options) const {
   InlierChi2Sums sums;
   double parameters = 6.0 * num_pose_variables_;
   for (int l = 0; l < num_landmarks_; ++l) {
     const Landmark& landmark = landmarks_[l];
-    int dof = 0, max_rank = 3;
+    int dof = 0;
+    bool line_sample = false, anchored = false;
     for (int k = 0; k < landmark.num_observations; ++k) {
       const Observation& obs = observations_[observation_order_[landmark.first_observation + k]];
       if (!obs.enabled || obs.outlier) continue;
       const int obs_dof = obs.kind == ObservationKind::kStereoPoint ? 3 : obs.kind == ObservationKind::kMonoPoint ? 2 : 1;
-      if (obs.kind == ObservationKind::kLineSample) max_rank = 2;
+      line_sample = line_sample || obs.kind == ObservationKind::kLineSample;
+      anchored = anchored || obs.kind != ObservationKind::kLineSample;
       sums.add(obs_dof, obs.chi2);
       dof += obs_dof;
     }
-    parameters += std::min(dof, max_rank);
+    // A line sample's slide along its line is unobservable unless its anchor pins it.
+    parameters += std::min(dof, line_sample && !anchored ? 2 : 3);
   }
   return plumb::varianceFactor(sums, parameters, options.chi2);
 }
@@ -35,10 +45,11 @@ PointVarianceComponents LocalBundleAdjuster::varianceComponents(const LocalBaOpt
   double parameters = 6.0 * num_pose_variables_;
   for (int l = 0; l < num_landmarks_; ++l) {
     const Landmark& landmark = landmarks_[l];
+    if (isLineSample(landmark)) continue;  // its anchor's residual is not a point's either
     int dof = 0;
     for (int k = 0; k < landmark.num_observations; ++k) {
       const Observation& obs = observations_[observation_order_[landmark.first_observation + k]];
-      if (!obs.enabled || obs.outlier || obs.kind == ObservationKind::kLineSample) continue;
+      if (!obs.enabled || obs.outlier) continue;
       if (obs.kind == ObservationKind::kMonoPoint) {
         pixel.add(2, obs.chi2);
         dof += 2;

@@ -73,6 +73,20 @@ Eigen::Matrix3d disparityTransform() {
 
 }  // namespace
 
+Eigen::Matrix3d lineSampleAnchorInformation(const NoiseModelOptions& options, const CameraIntrinsics& camera,
+                                            int pyramid_level, double depth_m, const Eigen::Vector2d& along,
+                                            double depth_sigma_scale) {
+  if (!(depth_m >= options.min_depth) || !(depth_sigma_scale > 0.0)) return Eigen::Matrix3d::Zero();
+  const double sigma_pixel = pixelSigma(options, pyramid_level);
+  // The disparity bf / d moves by bf / d^2 per metre of depth.
+  const double sigma_disparity = depth_sigma_scale * depthSigma(options, depth_m) * camera.bf / (depth_m * depth_m);
+  Eigen::Matrix3d information_y = Eigen::Matrix3d::Zero();  // y = [u, v, u - u_r]
+  information_y.topLeftCorner<2, 2>() = along * along.transpose() / (sigma_pixel * sigma_pixel);
+  information_y(2, 2) = 1.0 / (sigma_disparity * sigma_disparity);
+  const Eigen::Matrix3d T = disparityTransform();
+  return T.transpose() * information_y * T;
+}
+
 void splitStereoChi2(const Eigen::Matrix3d& information, const Eigen::Vector3d& e, double* pixel_chi2,
                      double* depth_chi2) {
   const Eigen::Matrix3d T = disparityTransform();

@@ -44,6 +44,20 @@ Eigen::Matrix2d monoPointInformation(const NoiseModelOptions& options, int pyram
 // l normalised): 1 / sigma_p(level)^2.
 double lineSampleInformation(const NoiseModelOptions& options, int pyramid_level);
 
+// 3x3 information of z = [u, v, u_r] for a line-guidance point in the keyframe that back-projected
+// it (its anchor; docs/ODOMETRY.md "Line samples keep their depth"). The line residuals measure a
+// sample only across its 2D lines, so without this its depth is whatever local BA leaves it at.
+//   - depth: a keypoint's disparity information with sigma_d times depth_sigma_scale (line pixels
+//     sit on object edges, where the depth is noisier: paper section V);
+//   - pixel: only along the 2D line (unit image direction `along`), with a keypoint's pixel sigma.
+//     Where on its line a sample sits is the sampler's choice, not a measurement: this pins the
+//     slide along the 3D line that no residual sees (it gives the poses no information). Across
+//     the line nothing: the anchor's line residual already measures that.
+// Zero when depth_m < options.min_depth.
+Eigen::Matrix3d lineSampleAnchorInformation(const NoiseModelOptions& options, const CameraIntrinsics& camera,
+                                            int pyramid_level, double depth_m, const Eigen::Vector2d& along,
+                                            double depth_sigma_scale);
+
 // The stereo residual [u, v, u_r] in the coordinates of its two noise sources, [u, v] (corner
 // detection) and the disparity u - u_r = bf / d (depth), where the model's information is block
 // diagonal. Used by the variance components (solver/local_ba.h, docs/UNCERTAINTY.md).

@@ -49,6 +49,7 @@ struct RunCommandOptions {
   // odometry
   long long line_samples = 5;   // --line-samples N
   bool no_lines = false;        // --no-lines
+  bool line_depth_anchor = false;  // --line-depth-anchor
   bool no_loops = false;        // --no-loops
   long long output_delay = 60;  // --output-delay N
   long long refine_lag = SystemOptions::kDefaultRefineLagFrames;  // --refine-lag M

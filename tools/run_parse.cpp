@@ -28,6 +28,9 @@ FlagTable runFlagTable(RunCommandOptions* o) {
       .integer("line-samples", "N", 0, long(kMaxLineSamples), &o->line_samples,
                "line-guidance points per line: 0 (points only) or 2..10 (default 5)")
       .toggle("no-lines", &o->no_lines, "points only (lines are neither mapped nor used for tracking)")
+      .toggle("line-depth-anchor", &o->line_depth_anchor,
+              "local BA keeps each line sample's measured depth in the keyframe that\n"
+              "made it (experimental, off by default: docs/ODOMETRY.md)")
       .text("out-optimized", "FILE", &o->out_optimized,
             "the optimised trajectory (TUM): every frame through its reference\n"
             "keyframe's pose in the final loop-closing pose graph (docs/LOOP.md)")

@@ -40,6 +40,7 @@ Status checkCombinations(const RunCommandOptions& o) {
 Status buildOptions(const RunCommandOptions& o, const std::atomic<bool>* stop, RunPlan* plan) {
   SystemOptions& system = plan->system_options;
   setLineSamples(int(o.line_samples), !o.no_lines, &system.odometry);
+  system.odometry.mapper.anchor_line_sample_depth = o.line_depth_anchor;
   system.output_delay_frames = int(o.output_delay);
   system.refine_lag_frames = int(o.refine_lag);
   PLUMB_RETURN_IF_ERROR(validate(system));

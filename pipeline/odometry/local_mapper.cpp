@@ -299,7 +299,10 @@ int LocalMapper::createLines(int kf_slot, const KeyframeRequest& request) {
     if (slot < 0) break;
     MapLine& l = map_.line(slot);
     l.num_samples = obs.num_samples;
-    for (int s = 0; s < obs.num_samples; ++s) l.samples_world[s] = T * obs.sample_P_cam[s].cast<double>();
+    for (int s = 0; s < obs.num_samples; ++s) {
+      l.samples_first_cam[s] = obs.sample_P_cam[s];
+      l.samples_world[s] = T * obs.sample_P_cam[s].cast<double>();
+    }
     Eigen::Vector3d start_cam, end_cam;
     mapLineEndpointsCam(camera_, obs, &start_cam, &end_cam);
     l.start_world = T * start_cam;

@@ -127,6 +127,9 @@ class LocalMapper {
   void selectWindow(int kf_slot);
   void excludeSingleViewLandmarks();
   void moveSingleViewLandmarks();
+  // Each BA line sample's depth in its first keyframe, when that keyframe is in the BA
+  // (LocalMapperOptions::anchor_line_sample_depth). After every other observation.
+  void addLineSampleAnchors();
   // local_mapper_covariance.cpp: after a BA's covariance, every window keyframe's relative pose
   // and covariance to its previous keyframe (when that BA held both); the new keyframe's world
   // covariance chained from its previous keyframe's.

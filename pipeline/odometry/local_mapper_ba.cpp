@@ -3,6 +3,8 @@
 
 #include "pipeline/odometry/local_mapper.h"
 
+#include "solver/noise_model.h"
+
 namespace plumb {
 
 // Ranks the keyframes sharing landmarks with kf_slot by shared count (newer first on ties) and
@@ -144,6 +146,35 @@ void LocalMapper::moveSingleViewLandmarks() {
   }
 }
 
+// A line sample is a 3D point measured only by its distance to the 2D line in each view, so its
+// depth is unobserved until views far enough apart triangulate it, and never when its line runs
+// along the motion. Its first keyframe measured that depth (the sampler back-projected it), so it
+// enters the BA like a keypoint's depth in that keyframe, with the noise model's sigma scaled
+// for object edges; its pixel only along the line (noise_model.h lineSampleAnchorInformation).
+void LocalMapper::addLineSampleAnchors() {
+  const CameraIntrinsics& K = intrinsics_;
+  for (uint32_t l : s_->ba_lines) {
+    const MapLine& line = map_.line(int(l));
+    const int kf_slot = map_.findKeyframeSlot(line.first_keyframe_id);
+    if (kf_slot < 0 || !line.observers.has(kf_slot)) continue;
+    const int kf_index = s_->ba_keyframe_index[kf_slot];
+    if (kf_index < 0) continue;  // the first keyframe is outside the BA
+    const KeyframeLineObservation& obs = map_.keyframe(kf_slot).lines[line.observers.obs_index[kf_slot]];
+    const Eigen::Vector2d normal = obs.l.head<2>().normalized();
+    const Eigen::Vector2d along(-normal.y(), normal.x());
+    const int first = s_->line_ba_first_index[l];
+    for (int s = 0; s < line.num_samples; ++s) {
+      const Eigen::Vector3d P = line.samples_first_cam[std::size_t(s)].cast<double>();
+      const Eigen::Matrix3d information = lineSampleAnchorInformation(
+          options_.extractor.noise, K, obs.octave, P.z(), along, options_.mapper.line_sample_depth_sigma_scale);
+      if (!(information(2, 2) > 0.0)) continue;  // no depth (below the noise model's minimum)
+      const double u = K.fx * P.x() / P.z() + K.cx;
+      const Eigen::Vector3d uvr(u, K.fy * P.y() / P.z() + K.cy, u - K.bf / P.z());
+      if (ba_.addStereoPointObservation(kf_index, first + s, uvr, information) < 0) return;  // full
+    }
+  }
+}
+
 void LocalMapper::runLocalBa(int kf_slot, InsertResult* result) {
   selectWindow(kf_slot);
   auto& window = s_->window;
@@ -205,6 +236,8 @@ void LocalMapper::runLocalBa(int kf_slot, InsertResult* result) {
   };
   for (int slot : window) add_keyframe_observations(slot);
   for (int slot : fixed) add_keyframe_observations(slot);
+  // After the others: the outlier bookkeeping below walks observations [0, num_obs) only.
+  if (options_.tracker.use_lines && options_.mapper.anchor_line_sample_depth) addLineSampleAnchors();
 
   const LocalBaSummary summary = ba_.solve(ba_options_);
   ++stats_.ba_runs;

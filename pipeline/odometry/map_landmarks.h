@@ -53,6 +53,9 @@ struct MapLine {
   Descriptor256 descriptor;  // LBD
   int8_t ref_octave = 0;
   uint32_t first_keyframe_id = 0;
+  // Each sample as its first keyframe back-projected it (camera frame, m): local BA's anchor
+  // observation of the sample's depth (LocalMapperOptions::anchor_line_sample_depth).
+  std::array<Eigen::Vector3f, kMaxLineSamples> samples_first_cam{};
   LandmarkObservers observers;
   LandmarkTrackingStats tracking;
   // Sample residuals classified as outliers by local BA, out of all sample residuals: a line

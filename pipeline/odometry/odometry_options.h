@@ -65,6 +65,17 @@ struct LocalMapperOptions {
   int min_observers = 2;
   int cull_after_keyframes = 3;
   float max_line_sample_outlier_ratio = 0.5f;  // lines whose BA samples fail this often go
+  // Line samples keep their depth (docs/ODOMETRY.md "Line samples keep their depth"; `plumb run
+  // --line-depth-anchor`): each sample enters local BA with a stereo observation in the keyframe
+  // that back-projected it, its depth with a keypoint's sigma times `line_sample_depth_sigma_scale`
+  // (2: line pixels sit on object edges, where depth is noisier, paper section V; 1 and 2 were
+  // measured), its pixel only along its 2D line. Without it a sample seen by two keyframes has no
+  // depth information at all: the first BAs of the noise-free office moved samples a median 35 mm
+  // (p90 28 cm) across their lines, which tracking then used as fixed. OFF by default until its
+  // interaction with loop closing is settled: the odometry gains on every line-rich family, but
+  // head250's loops got worse (docs/ODOMETRY.md).
+  bool anchor_line_sample_depth = false;
+  double line_sample_depth_sigma_scale = 2.0;
   // Whether the observations local BA's solve() flags as outliers leave the map (and count toward
   // a line's sample outlier ratio above). Off: a binary-pair study (docs/ODOMETRY.md "Local BA
   // outlier culling") found no gain on average (head250 six-start mean --out -0.7 %,

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Core>
 #include <gtest/gtest.h>
 
 namespace plumb {
@@ -84,6 +85,33 @@ TEST(NoiseModel, BackProjectedPointCovariance) {
     const Eigen::Matrix3d covariance = backProjectedPointCovariance(options, camera, u, v, d, level);
     EXPECT_LT((covariance - expected).norm() / expected.norm(), 1e-8) << fy;
   }
+}
+
+// A line sample's anchor: its disparity measured like a keypoint's with sigma_d scaled, its pixel
+// only along the 2D line (nothing across it: the line residual measures that).
+TEST(NoiseModel, LineSampleAnchorMeasuresDepthAndTheSlideNotTheLineOffset) {
+  const NoiseModelOptions options;
+  const double depth = 2.0, scale = 2.0;
+  const Eigen::Vector2d along = Eigen::Vector2d(3.0, 4.0).normalized();
+  const Eigen::Vector2d across(-along.y(), along.x());
+  const Eigen::Matrix3d info = lineSampleAnchorInformation(options, kCamera, 1, depth, along, scale);
+  // z = [u, v, u_r]: a pixel shift moves u and u_r together, a disparity change u_r alone.
+  const auto chi2 = [&](const Eigen::Vector2d& dp, double d_disparity) {
+    const Eigen::Vector3d dz(dp.x(), dp.y(), dp.x() - d_disparity);
+    return dz.dot(info * dz);
+  };
+  EXPECT_NEAR(chi2(across, 0.0), 0.0, 1e-12);
+  const double sigma_pixel = pixelSigma(options, 1);
+  EXPECT_NEAR(chi2(along, 0.0), 1.0 / (sigma_pixel * sigma_pixel), 1e-9);
+  const double sigma_disparity = scale * depthSigma(options, depth) * kCamera.bf / (depth * depth);
+  EXPECT_NEAR(chi2(Eigen::Vector2d::Zero(), sigma_disparity), 1.0, 1e-9);
+  // The keypoint's own disparity information, for comparison: scale^2 larger.
+  const Eigen::Matrix3d keypoint = stereoPointInformation(options, kCamera, 1, depth);
+  const Eigen::Vector3d dz_disparity(0.0, 0.0, -1.0);
+  EXPECT_NEAR(dz_disparity.dot(keypoint * dz_disparity) / dz_disparity.dot(info * dz_disparity), scale * scale, 1e-9);
+  // No depth (below the model's minimum) or no scale: nothing.
+  EXPECT_TRUE(lineSampleAnchorInformation(options, kCamera, 1, 0.01, along, scale).isZero());
+  EXPECT_TRUE(lineSampleAnchorInformation(options, kCamera, 1, depth, along, 0.0).isZero());
 }
 
 }  // namespace
