@@ -130,7 +130,9 @@ void expectSameBits3x3(const Eigen::Matrix3d& got, const Eigen::Matrix3d& expect
 #else
     if (!std::isfinite(expected(i))) {
       ASSERT_EQ(std::isnan(got(i)), std::isnan(expected(i))) << trial << " entry " << i;
-      if (!std::isnan(expected(i))) ASSERT_EQ(got(i), expected(i)) << trial << " entry " << i;
+      if (!std::isnan(expected(i))) {
+        ASSERT_EQ(got(i), expected(i)) << trial << " entry " << i;
+      }
       continue;
     }
     ASSERT_NEAR(got(i), expected(i), 1e-12 * std::max(1.0, std::abs(expected(i))))
