@@ -3,6 +3,7 @@
 
 #include "pipeline/odometry/local_mapper.h"
 
+#include "solver/factors.h"
 #include "solver/noise_model.h"
 
 namespace plumb {
@@ -168,8 +169,8 @@ void LocalMapper::addLineSampleAnchors() {
       const Eigen::Matrix3d information = lineSampleAnchorInformation(
           options_.extractor.noise, K, obs.octave, P.z(), along, options_.mapper.line_sample_depth_sigma_scale);
       if (!(information(2, 2) > 0.0)) continue;  // no depth (below the noise model's minimum)
-      const double u = K.fx * P.x() / P.z() + K.cx;
-      const Eigen::Vector3d uvr(u, K.fy * P.y() / P.z() + K.cy, u - K.bf / P.z());
+      Eigen::Vector3d uvr;  // where the stereo factor predicts it: its residual against zero
+      stereoResidualAt(K, P, Eigen::Vector3d::Zero(), &uvr, nullptr);
       if (ba_.addStereoPointObservation(kf_index, first + s, uvr, information) < 0) return;  // full
     }
   }
