@@ -118,8 +118,10 @@ def evaluate(args, seq):
         row.update({k: grading.get(k, 0) for k in ("accepted", "graded", "correct", "within_5cm_2deg", "revisits",
                                                    "revisits_recalled")})
         # NEES of each graded loop constraint: error_sigmas^2 = e^T S^-1 e (6 dof).
-        row["nees"] = [l["error_sigmas"] ** 2 for l in grading.get("loops", [])
-                       if l.get("ground_truth") and l.get("error_sigmas") is not None]
+        graded = [l for l in grading.get("loops", []) if l.get("ground_truth") and l.get("error_sigmas") is not None]
+        row["nees"] = [l["error_sigmas"] ** 2 for l in graded]
+        # (true baseline between the two views [m], NEES, error [m]) per loop: the table by baseline.
+        row["by_baseline"] = [(l.get("baseline_m", 0.0), l["error_sigmas"] ** 2, l["error_m"]) for l in graded]
     with open(base + ".stats.json") as f:
         stats = json.load(f)
     lc = stats.get("loop_closing", {})
@@ -163,6 +165,7 @@ def main():
     print("|---|---|---|---|---|---|---|---|---|---|")
     totals = {"rows": 0, "fail_rt": 0, "fail_opt": 0, "accepted": 0, "correct": 0, "revisits": 0, "recalled": 0}
     all_nees = []
+    all_by_baseline = []  # (family, baseline, NEES, error)
     for r in rows:
         if "error" in r or r.get("noloops") is None or r.get("rt") is None or r.get("opt") is None:
             print(f"| {r['name']} | {r.get('error', 'evaluation failed')} | | | | | | | | |")
@@ -185,6 +188,8 @@ def main():
         totals["correct"] += correct
         nees = r.get("nees", [])
         all_nees += nees
+        family = r["name"].split(":")[0] + (" noise" if r["name"].endswith(" noise") else "")
+        all_by_baseline += [(family,) + x for x in r.get("by_baseline", [])]
         nees_cell = f"{sum(nees) / len(nees) / 6:.2f} ({max(nees) / 6:.2f})" if nees else "-"
         recall = "-"
         if r["looped"] and r.get("revisits"):
@@ -204,6 +209,22 @@ def main():
         inside = sum(1 for x in all_nees if x <= 12.59)  # 6-dof chi-square, 95 %
         print(f"Loop constraints: mean NEES/dof {sum(all_nees) / len(all_nees) / 6:.2f} over {len(all_nees)} "
               f"accepted loops, {100.0 * inside / len(all_nees):.0f} % inside the 95 % ellipsoid.")
+    if all_by_baseline:
+        # A loop's error grows with how far apart its two views are (docs/LOOP.md "Loop error
+        # against baseline"): the calibration must hold in every bin, not only on average.
+        print()
+        print("| family | views apart | loops | mean NEES/dof | median error [mm] |")
+        print("|---|---|---|---|---|")
+        bins = [(0.0, 0.25), (0.25, 0.5), (0.5, 1.0), (1.0, float("inf"))]
+        for family in sorted({x[0] for x in all_by_baseline}):
+            for lo, hi in bins:
+                cell = [x for x in all_by_baseline if x[0] == family and lo <= x[1] < hi]
+                if not cell:
+                    continue
+                errors = sorted(x[3] for x in cell)
+                span = f"{lo:g}-{hi:g} m" if hi != float("inf") else f">= {lo:g} m"
+                print(f"| {family} | {span} | {len(cell)} | {sum(x[2] for x in cell) / len(cell) / 6:.2f} | "
+                      f"{1000 * errors[len(errors) // 2]:.1f} |")
 
 
 if __name__ == "__main__":

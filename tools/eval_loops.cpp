@@ -27,12 +27,15 @@ int evalLoops(const std::vector<StampedPose>& ground_truth, const std::string& s
     for (std::size_t i = 0; i < g.loops.size(); ++i) {
       const GradedLoop& l = g.loops[i];
       std::printf("%s\n  {\"query_id\": %u, \"query_t\": %.6f, \"candidate_id\": %u, \"candidate_t\": %.6f, "
-                  "\"ground_truth\": %s, \"error_m\": %s, \"error_deg\": %s, \"error_sigmas\": %s, \"correct\": %s}",
+                  "\"ground_truth\": %s, \"error_m\": %s, \"error_deg\": %s, \"error_sigmas\": %s, \"baseline_m\": %s, "
+                  "\"baseline_deg\": %s, \"correct\": %s}",
                   i ? "," : "", l.query_id, l.query_t, l.candidate_id, l.candidate_t,
                   l.has_ground_truth ? "true" : "false",
                   l.has_ground_truth ? jsonNumber(l.error_m, "%.5f").c_str() : "null",
                   l.has_ground_truth ? jsonNumber(l.error_deg, "%.4f").c_str() : "null",
                   l.has_ground_truth ? jsonNumber(l.error_sigmas, "%.3f").c_str() : "null",
+                  l.has_ground_truth ? jsonNumber(l.baseline_m, "%.4f").c_str() : "null",
+                  l.has_ground_truth ? jsonNumber(l.baseline_deg, "%.2f").c_str() : "null",
                   l.correct ? "true" : "false");
     }
     std::printf("]}\n");
@@ -46,9 +49,10 @@ int evalLoops(const std::vector<StampedPose>& ground_truth, const std::string& s
                   l.candidate_id, l.candidate_t);
       continue;
     }
-    std::printf("  query %u (t %.3f) -> candidate %u (t %.3f): error %.4f m, %.3f deg, %.2f sigma  %s\n", l.query_id,
-                l.query_t, l.candidate_id, l.candidate_t, l.error_m, l.error_deg, l.error_sigmas,
-                l.correct ? "correct" : "WRONG");
+    std::printf("  query %u (t %.3f) -> candidate %u (t %.3f): error %.4f m, %.3f deg, %.2f sigma  %s"
+                "  (views %.3f m, %.1f deg apart)\n",
+                l.query_id, l.query_t, l.candidate_id, l.candidate_t, l.error_m, l.error_deg, l.error_sigmas,
+                l.correct ? "correct" : "WRONG", l.baseline_m, l.baseline_deg);
   }
   std::printf("loop precision %.1f %% (%zu of %zu correct: <= %.0f cm, <= %.0f deg, chi2 <= %.2f)\n",
               100.0 * g.precision(), g.correct, g.graded, options.max_error_m * 100, options.max_error_deg,

@@ -5,7 +5,8 @@
 // Per ACCEPTED loop: the error of its constraint Z = T_candidate_query against the ground-truth
 // relative pose G_c^-1 G_q, as e = log(G_q^-1 G_c Z) (a left perturbation of T_query_candidate,
 // the convention of the covariance the audit stores): translation |t| in m, rotation angle in deg,
-// and the Mahalanobis distance sqrt(e^T S^-1 e) in sigmas of the constraint's own covariance S.
+// and the Mahalanobis distance sqrt(e^T S^-1 e) in sigmas of the constraint's own covariance S;
+// also the true baseline between the two keyframes (m, deg), which the error is studied against.
 // A loop is CORRECT when its error is within 5 cm AND 2 deg AND e^T S^-1 e <= 20.06 (the 6-dof
 // chi-square with the probability of a 1-D 3-sigma interval, 99.73 %). Precision = correct /
 // accepted.
@@ -66,6 +67,9 @@ struct GradedLoop {
   double query_t = 0, candidate_t = 0;
   bool has_ground_truth = false;
   double error_m = 0, error_deg = 0, error_sigmas = 0;
+  // How far apart the two views truly are (G_c^-1 G_q): a loop's error grows with its baseline,
+  // which its covariance must follow (docs/LOOP.md "Loop error against baseline").
+  double baseline_m = 0, baseline_deg = 0;
   bool correct = false;
 };
 
