@@ -148,10 +148,10 @@ LoopGrading gradeLoops(const std::vector<StampedPose>& gt, const LoopAuditFile& 
     l.has_ground_truth =
         groundTruthAt(gt, c.query_t, o.max_gt_gap_s, &G_q) && groundTruthAt(gt, c.candidate_t, o.max_gt_gap_s, &G_c);
     if (l.has_ground_truth) {
-      // T_query_candidate = Z^-1 is perturbed on the left: true = exp(e) Z^-1, e = log(G_q^-1 G_c Z).
       const Eigen::Isometry3d G_candidate_query = G_c.inverse() * G_q;
       l.baseline_m = G_candidate_query.translation().norm();
       l.baseline_deg = Eigen::AngleAxisd(G_candidate_query.linear()).angle() * kDegreesPerRadian;
+      // T_query_candidate = Z^-1 is perturbed on the left: true = exp(e) Z^-1, e = log(G_q^-1 G_c Z).
       const Eigen::Isometry3d E = G_q.inverse() * G_c * c.T_candidate_query;
       const Vector6d e = logSE3(E);
       l.error_m = E.translation().norm();
